@@ -1,0 +1,99 @@
+//! Shell: reads a system file and its WAMIT database from disk and hands the text to the pure readers.
+//! The only module of the library that touches the file system.
+
+use crate::hydro::system::SystemSpec;
+use crate::hydro::wamit::{self, Scaling};
+use crate::hydro::{self, VesselSystem};
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+/// Errors of the file layer: the file that could not be opened, or what the reader found in it.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error(transparent)]
+    Hydro(#[from] hydro::Error),
+}
+
+fn open(path: &Path) -> Result<BufReader<File>, Error> {
+    File::open(path).map(BufReader::new).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// A loaded system, with notes on the optional files found beside it.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub system: VesselSystem,
+    /// The files read, in order.
+    pub files: Vec<PathBuf>,
+    /// Observations on optional files (e.g. `.3fk + .3sc` against `.3`).
+    pub notes: Vec<String>,
+}
+
+/// Loads `system.toml` and the WAMIT files it names (`.1`, `.3` or else `.2`, `.hst`; `.3fk` and
+/// `.3sc` when present are read and checked against the total excitation).
+pub fn load_system(path: &Path) -> Result<Loaded, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let spec = SystemSpec::from_toml(&text, &path.display().to_string())?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let stem = dir.join(&spec.wamit_stem);
+    let with_ext = |ext: &str| PathBuf::from(format!("{}.{ext}", stem.display()));
+    let n = spec.n_modes();
+    let s = Scaling {
+        rho: spec.rho_kg_m3,
+        g: spec.g_m_s2,
+        ulen: spec.ulen_m,
+    };
+    let mut files = vec![path.to_path_buf()];
+    let p1 = with_ext("1");
+    let rad = wamit::read_radiation(open(&p1)?, &p1.display().to_string(), n, s)?;
+    files.push(p1);
+    let p3 = if with_ext("3").exists() || !with_ext("2").exists() {
+        with_ext("3")
+    } else {
+        with_ext("2")
+    };
+    let exc = wamit::read_excitation(open(&p3)?, &p3.display().to_string(), n, s)?;
+    files.push(p3.clone());
+    let phst = with_ext("hst");
+    let hst = wamit::read_hydrostatics(open(&phst)?, &phst.display().to_string(), n, s)?;
+    files.push(phst);
+    let mut notes = vec![];
+    let (pfk, psc) = (with_ext("3fk"), with_ext("3sc"));
+    if pfk.exists() && psc.exists() {
+        let fk = wamit::read_excitation(open(&pfk)?, &pfk.display().to_string(), n, s)?;
+        let sc = wamit::read_excitation(open(&psc)?, &psc.display().to_string(), n, s)?;
+        notes.push(match wamit::sum_mismatch(&fk, &sc, &exc) {
+            Some(e) => format!(
+                "Froude-Krylov + scattering ({}, {}) against the total: largest difference {:.3e} of the largest |X|",
+                pfk.display(),
+                psc.display(),
+                e
+            ),
+            None => {
+                "Froude-Krylov and scattering files do not share the total's frequencies and headings: not compared"
+                    .into()
+            }
+        });
+        files.push(pfk);
+        files.push(psc);
+    }
+    let label = stem.display().to_string();
+    let system = VesselSystem::assemble(spec, rad, exc, hst, &label)?;
+    Ok(Loaded { system, files, notes })
+}
+
+/// Reads a CSV or text file whole (for the CLI's own inputs).
+pub fn read_text(path: &Path) -> Result<String, Error> {
+    std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}

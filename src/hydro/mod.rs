@@ -1,0 +1,90 @@
+//! The vessel system and its hydrodynamic database (pure: values in, values out, no IO).
+//!
+//! Owns: the WAMIT readers ([`wamit`]), the system file ([`system`]), the assembled database with its
+//! interpolation over frequency and heading ([`db`]), and radiation memory: impulse response functions,
+//! A_inf and the Kramers-Kronig check ([`radiation`]).
+//!
+//! Conventions (DESIGN.md section 1, contracts):
+//! - SI units: m, s, kg, N, rad. Degrees only where a name says `_deg`.
+//! - Body frame: x forward, y to port, z up, origin at the body's WAMIT reference point.
+//! - DOF order per vessel: surge, sway, heave, roll, pitch, yaw; vessel k owns indices 6k..6k+5
+//!   (0-based), i.e. WAMIT modes 6k+1..6k+6.
+//! - Complex amplitudes are for exp(+i w t) (WAMIT's convention). A wave heading beta is the direction the
+//!   wave travels to, counterclockwise from +x (180 deg = head seas).
+//! - Excitation X(w, beta) is the force per metre of wave amplitude referred to the wave phase at the
+//!   database's global origin.
+
+pub mod check;
+pub mod db;
+pub mod radiation;
+pub mod system;
+pub mod wamit;
+
+pub use db::HydroDb;
+pub use system::{Body, VesselSystem};
+
+/// Degrees of freedom of one vessel, in DESIGN.md order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Dof {
+    Surge,
+    Sway,
+    Heave,
+    Roll,
+    Pitch,
+    Yaw,
+}
+
+impl Dof {
+    pub const ALL: [Dof; 6] = [Dof::Surge, Dof::Sway, Dof::Heave, Dof::Roll, Dof::Pitch, Dof::Yaw];
+
+    /// Lower-case name as used in system files and outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dof::Surge => "surge",
+            Dof::Sway => "sway",
+            Dof::Heave => "heave",
+            Dof::Roll => "roll",
+            Dof::Pitch => "pitch",
+            Dof::Yaw => "yaw",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Dof> {
+        Dof::ALL.into_iter().find(|d| d.name() == name.to_ascii_lowercase())
+    }
+
+    /// Index 0..5 within a vessel.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Translations are in m, rotations in rad.
+    pub fn is_rotation(self) -> bool {
+        self.index() >= 3
+    }
+
+    /// The DOF of a 0-based global index (6k + j).
+    pub fn of_index(global: usize) -> Dof {
+        Dof::ALL[global % 6]
+    }
+}
+
+/// Errors from reading or validating a vessel system and its database. Each names where the problem is
+/// (file, line, key) and what was expected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A line of a data file could not be read.
+    #[error("{file}:{line}: {msg}")]
+    Parse { file: String, line: usize, msg: String },
+    /// A key of the system file is missing, unknown or has an invalid value.
+    #[error("{file}: {key}: {msg}")]
+    Key { file: String, key: String, msg: String },
+    /// The data are readable but inconsistent or unusable.
+    #[error("{file}: {msg}")]
+    Invalid { file: String, msg: String },
+    /// A request outside what the database covers (frequency, heading, speed).
+    #[error("{0}")]
+    OutOfRange(String),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,9 @@
+//! shipcast: real-time motion forecasts for one or more ships, from a Cummins reduced-order model driven
+//! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
+//!
+//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`].
+//! Imperative shell: [`files`] (reading systems and databases from disk) and the `shipcast` binary.
+
+pub mod files;
+pub mod hydro;
+pub mod rao;

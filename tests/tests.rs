@@ -1,0 +1,11 @@
+//! shipcast's integration tests: one binary, one module per subject. Validation modules are named for
+//! the outside source they check against (Capytaine, WEC-Sim); every tolerance is a named constant with
+//! a one-line reason.
+
+mod util;
+
+mod bad_input;
+mod capytaine_demo;
+mod core_purity;
+mod kramers_kronig;
+mod wecsim_rm3;

@@ -1,0 +1,281 @@
+#!/usr/bin/env python3
+"""Build a shipcast vessel database with Capytaine (a BEM code on PyPI).
+
+Writes, into OUTDIR:
+  <stem>.1, <stem>.3, <stem>.hst   WAMIT-format files (ULEN = 1, no header line), modes 1..6N
+  system.toml                      the shipcast system file (bodies, mass properties, positions)
+  capytaine_rao.csv                Capytaine's own motion RAO, `omega,heading_deg,mode,amplitude,phase_deg`,
+                                   converted to the exp(+i w t) convention (conjugated), for validation
+  bem_info.toml                    what was run: mesh sizes, frequencies, run time, Capytaine version
+
+Conventions (shipcast DESIGN.md section 1): body frame x forward, y port, z up; each body's rotations are
+about its own reference point (at the waterline above midship); excitation phases refer to the global
+origin (a multi-body database, so shipcast applies no extra shift); wave heading beta is the direction the
+waves travel to, counterclockwise from +x. Capytaine works in exp(-i w t): every complex value written here
+is conjugated into WAMIT's exp(+i w t).
+
+Hulls are modified Wigley forms (Journee 1992 / Kashiwagi): half-breadth
+  y = B/2 [ (1 - z'^2)(1 - x'^2)(1 + a2 x'^2 + a4 x'^4) + kappa z'^2 (1 - z'^8)(1 - x'^2)^4 ]
+with x' = 2x/L, z' = -z/T (a2 = 0.6, a4 = 1, kappa = 1: block coefficient about 0.56), or a box.
+
+Usage: python3 make_db.py --preset ship OUTDIR      (one 180 m ship)
+       python3 make_db.py --preset pair OUTDIR      (180 m ship + 120 m ship side by side, 5 m gap)
+       python3 make_db.py --preset box-test OUTDIR  (tiny, seconds: a smoke test of this script)
+"""
+
+import argparse
+import math
+import sys
+import time
+
+import numpy as np
+import xarray as xr
+import capytaine as cpt
+
+RHO = 1025.0
+G = 9.81
+DOF_NAMES = ["Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw"]
+
+
+def wigley_mesh(length, beam, draft, nx, nz, a2=0.6, a4=1.0, kappa=1.0):
+    """Quad panels of a modified Wigley hull, centred at the origin, waterline at z = 0.
+
+    Vertical stations are placed for equal girth at midship so the bilge is resolved."""
+
+    def half_breadth(xp, zp):
+        return 0.5 * beam * ((1 - zp**2) * (1 - xp**2) * (1 + a2 * xp**2 + a4 * xp**4)
+                             + kappa * zp**2 * (1 - zp**8) * (1 - xp**2) ** 4)
+
+    # equal-girth z' stations at midship
+    fine = np.linspace(0.0, 1.0, 2001)
+    ys = half_breadth(0.0, fine)
+    zs = -draft * fine
+    seg = np.hypot(np.diff(ys), np.diff(zs))
+    girth = np.concatenate([[0.0], np.cumsum(seg)])
+    zp_st = np.interp(np.linspace(0.0, girth[-1], nz + 1), girth, fine)
+    xp_st = np.linspace(-1.0, 1.0, nx + 1)
+    pts = np.zeros((nx + 1, nz + 1, 3))
+    for i, xp in enumerate(xp_st):
+        for j, zp in enumerate(zp_st):
+            pts[i, j] = (0.5 * length * xp, half_breadth(xp, zp), -draft * zp)
+    faces = []
+    for i in range(nx):
+        for j in range(nz):
+            # port side (y >= 0): outward normal points to +y (checked by the positive volume below)
+            port = [pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]]
+            faces.append(port)
+            stbd = [p * np.array([1.0, -1.0, 1.0]) for p in port[::-1]]
+            faces.append(stbd)
+    return cpt.Mesh.from_list_of_faces(np.array(faces), name="wigley")
+
+
+def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_m, radii):
+    if hull == "wigley":
+        nx = max(8, int(math.ceil(length / panel_m)))
+        nz = max(3, int(math.ceil((draft + 0.5 * beam) / panel_m)))
+        mesh = wigley_mesh(length, beam, draft, nx, nz)
+    elif hull == "box":
+        mesh = cpt.mesh_parallelepiped(size=(length, beam, draft), center=(0, 0, -draft / 2),
+                                       resolution=(max(4, int(length / panel_m)),
+                                                   max(2, int(beam / panel_m)),
+                                                   max(2, int(draft / panel_m))),
+                                       missing_sides={"top"})
+        mesh = mesh.immersed_part()
+    else:
+        raise ValueError(f"unknown hull {hull}")
+    mesh = mesh.translated(position)
+    # Lid against irregular frequencies. Capytaine's lowest_lid_position assumes a rectangular waterplane;
+    # a ship's narrows toward the ends, which lowers the irregular frequencies: with the lid placed for
+    # omega_max itself a spike (negative heave damping) remained at 1.525 rad/s on the 180 m hull, placed
+    # for 1.25 omega_max it is gone (checked at 1.45-1.6 rad/s). NaN means no irregular frequency below
+    # that bound for any lid depth: then put it just under the waterline.
+    z_lid = float(mesh.lowest_lid_position(1.25 * omega_max, g=G))
+    if not math.isfinite(z_lid) or z_lid > -0.05 * draft:
+        z_lid = -0.05 * draft
+    lid = mesh.generate_lid(z=z_lid, faces_max_radius=0.75 * panel_m)
+    dofs = cpt.rigid_body_dofs(rotation_center=np.array(position, dtype=float))
+    body = cpt.FloatingBody(mesh=mesh, lid_mesh=lid, dofs=dofs, name=name)
+    volume = body.disp_volume
+    if volume <= 0:
+        raise RuntimeError(f"{name}: non-positive volume {volume}: panel orientation is wrong")
+    cob = np.array(body.center_of_buoyancy)
+    mass = RHO * volume
+    # equilibrium: centre of gravity above the centre of buoyancy, at KG = kg_m above the keel
+    cog = np.array([cob[0], cob[1], -draft + kg_m])
+    body.mass = mass
+    body.center_of_mass = cog
+    return body, mass, cog, z_lid
+
+
+def mass_matrix(mass, cog_rel, radii):
+    """6x6 rigid-body mass matrix about the reference point; cog_rel = CoG - reference point."""
+    x, y, z = cog_rel
+    skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    ig = np.diag([mass * r**2 for r in radii])
+    io = ig + mass * (np.dot(cog_rel, cog_rel) * np.eye(3) - np.outer(cog_rel, cog_rel))
+    m = np.zeros((6, 6))
+    m[:3, :3] = mass * np.eye(3)
+    m[:3, 3:] = -mass * skew
+    m[3:, :3] = mass * skew
+    m[3:, 3:] = io
+    return m
+
+
+PRESETS = {
+    # one full-scale ship: 180 m x 30 m x 10 m, modified Wigley
+    "ship": dict(
+        stem="ship",
+        bodies=[dict(name="carrier", hull="wigley", length=180.0, beam=30.0, draft=10.0,
+                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180))],
+        panel_m=3.0,
+        omegas=np.round(np.arange(0.05, 1.6001, 0.025), 4),
+        headings_deg=np.arange(0.0, 360.0, 30.0),
+    ),
+    # two ships side by side: the carrier and a 120 m x 20 m x 7 m lighter to port, 5 m gap at the waterline
+    "pair": dict(
+        stem="pair",
+        bodies=[dict(name="carrier", hull="wigley", length=180.0, beam=30.0, draft=10.0,
+                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180)),
+                dict(name="lighter", hull="wigley", length=120.0, beam=20.0, draft=7.0,
+                     position=(0.0, 30.0, 0.0), kg_m=7.5, radii=(0.35 * 20, 0.25 * 120, 0.26 * 120))],
+        panel_m=3.0,
+        # gap resonances live between about 0.8 and 1.6 rad/s: sample them at 0.005 rad/s
+        omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6001, 0.005)]), 4),
+        headings_deg=np.arange(0.0, 360.0, 30.0),
+    ),
+    # a smoke test of this script (seconds)
+    "box-test": dict(
+        stem="box",
+        bodies=[dict(name="box", hull="box", length=20.0, beam=8.0, draft=3.0,
+                     position=(0.0, 0.0, 0.0), kg_m=2.0, radii=(3.0, 5.0, 5.5))],
+        panel_m=2.0,
+        omegas=np.array([0.5, 1.0, 1.5]),
+        headings_deg=np.array([0.0, 90.0, 180.0]),
+    ),
+}
+
+
+def fmt(v):
+    return f"{v:.7e}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--preset", choices=sorted(PRESETS), required=True)
+    ap.add_argument("outdir")
+    args = ap.parse_args()
+    p = PRESETS[args.preset]
+    import os
+    os.makedirs(args.outdir, exist_ok=True)
+    t0 = time.time()
+    omegas = np.asarray(p["omegas"], dtype=float)
+    omega_max = float(omegas.max())
+    built = [make_body(b["name"], b["hull"], b["length"], b["beam"], b["draft"], b["position"], p["panel_m"],
+                       omega_max, b["kg_m"], b["radii"]) for b in p["bodies"]]
+    bodies = [b[0] for b in built]
+    for (body, mass, cog, z_lid), spec in zip(built, p["bodies"]):
+        m = mass_matrix(mass, cog - np.array(spec["position"]), spec["radii"])
+        body.inertia_matrix = body.add_dofs_labels_to_matrix(m)
+        body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness(rho=RHO, g=G)
+        print(f"{body.name}: {body.mesh.nb_faces} hull panels, {body.lid_mesh.nb_faces} lid panels at "
+              f"z = {z_lid:.2f} m, mass {mass:.4e} kg, CoG {cog}", flush=True)
+    system = bodies[0] if len(bodies) == 1 else cpt.Multibody(bodies)
+    dof_names = list(system.dofs.keys())
+    nmodes = len(dof_names)
+    solver = cpt.BEMSolver()
+
+    headings_rad = np.radians(p["headings_deg"])
+    test = xr.Dataset(coords={"omega": omegas, "wave_direction": headings_rad,
+                              "radiating_dof": dof_names, "water_depth": [np.inf], "rho": [RHO], "g": [G]})
+    ds = solver.fill_dataset(test, system, progress_bar=False)
+    # infinite-frequency and zero-frequency added mass (radiation only)
+    limits = xr.Dataset(coords={"omega": [0.0, np.inf], "radiating_dof": dof_names, "water_depth": [np.inf],
+                                "rho": [RHO], "g": [G]})
+    ds_lim = solver.fill_dataset(limits, system, progress_bar=False)
+    t_solve = time.time() - t0
+
+    mmat = np.asarray(system.inertia_matrix)
+    cmat = np.asarray(system.hydrostatic_stiffness)
+    ds["inertia_matrix"] = system.inertia_matrix
+    ds["hydrostatic_stiffness"] = system.hydrostatic_stiffness
+    rao = cpt.post_pro.rao(ds)
+
+    def sel(da, **kw):
+        return np.asarray(da.sel(**kw).squeeze().values)
+
+    stem = os.path.join(args.outdir, p["stem"])
+    # .1: PER I J Abar Bbar; A = rho Abar, B = rho w Bbar (ULEN = 1)
+    with open(stem + ".1", "w") as f:
+        lim_a = ds_lim["added_mass"]
+        for omega, per in ((0.0, -1.0), (np.inf, 0.0)):
+            a = sel(lim_a, omega=omega).reshape(nmodes, nmodes)  # (radiating, influenced)
+            for i in range(nmodes):
+                for j in range(nmodes):
+                    # WAMIT A_ij: force in mode i due to motion in mode j
+                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(a[j, i] / RHO)}\n")
+        for omega in omegas:
+            a = np.asarray(ds["added_mass"].sel(omega=omega).transpose("radiating_dof", "influenced_dof").values)
+            b = np.asarray(ds["radiation_damping"].sel(omega=omega)
+                           .transpose("radiating_dof", "influenced_dof").values)
+            per = 2 * np.pi / omega
+            for i in range(nmodes):
+                for j in range(nmodes):
+                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(a[j, i] / RHO)} {fmt(b[j, i] / (RHO * omega))}\n")
+    # .3: PER BETA I |X| phase Re Im; X = rho g (Re + i Im), exp(+i w t): conjugate Capytaine's value
+    with open(stem + ".3", "w") as f:
+        exc = ds["excitation_force"].transpose("omega", "wave_direction", "influenced_dof")
+        for io_, omega in enumerate(omegas):
+            per = 2 * np.pi / omega
+            for ib, beta in enumerate(p["headings_deg"]):
+                for i in range(nmodes):
+                    x = np.conj(complex(exc.values[io_, ib, i])) / (RHO * G)
+                    f.write(f"{fmt(per)} {fmt(beta)} {i + 1:3d} {fmt(abs(x))} {fmt(np.degrees(np.angle(x)))} "
+                            f"{fmt(x.real)} {fmt(x.imag)}\n")
+    # .hst: I J Cbar, C = rho g Cbar
+    with open(stem + ".hst", "w") as f:
+        for i in range(nmodes):
+            for j in range(nmodes):
+                f.write(f"{i + 1:3d} {j + 1:3d} {fmt(cmat[i, j] / (RHO * G))}\n")
+    # Capytaine's own RAO, exp(+i w t)
+    with open(os.path.join(args.outdir, "capytaine_rao.csv"), "w") as f:
+        f.write("omega,heading_deg,mode,amplitude,phase_deg\n")
+        r = rao.transpose("omega", "wave_direction", "radiating_dof").values
+        for io_, omega in enumerate(omegas):
+            for ib, beta in enumerate(p["headings_deg"]):
+                for i in range(nmodes):
+                    x = np.conj(complex(r[io_, ib, i]))
+                    f.write(f"{omega:.6g},{beta:.6g},{i + 1},{abs(x):.9e},{np.degrees(np.angle(x)):.6f}\n")
+    # system.toml
+    with open(os.path.join(args.outdir, "system.toml"), "w") as f:
+        f.write(f"# shipcast system file, written by tools/bem/make_db.py --preset {args.preset}\n")
+        f.write(f"# Capytaine {cpt.__version__}; conventions: shipcast DESIGN.md section 1\n")
+        f.write(f'wamit = "{p["stem"]}"\nulen = 1.0\nrho = {RHO}\ng = {G}\nwater_depth = "infinite"\n')
+        f.write("hydrodynamic_coupling = true\n")
+        for (body, mass, cog, _), spec in zip(built, p["bodies"]):
+            pos = np.array(spec["position"], dtype=float)
+            f.write(f'\n[[body]]\nname = "{spec["name"]}"\n')
+            f.write(f"# {spec['hull']} hull, L = {spec['length']} m, B = {spec['beam']} m, T = {spec['draft']} m\n")
+            f.write(f"position = [{pos[0]:.6g}, {pos[1]:.6g}, {pos[2]:.6g}]\n")
+            f.write(f"mass = {mass:.9e}\n")
+            rel = cog - pos
+            f.write(f"centre_of_gravity = [{rel[0]:.9g}, {rel[1]:.9g}, {rel[2]:.9g}]   # relative to position\n")
+            f.write(f"radii_of_gyration = [{spec['radii'][0]:.9g}, {spec['radii'][1]:.9g}, {spec['radii'][2]:.9g}]\n")
+    with open(os.path.join(args.outdir, "bem_info.toml"), "w") as f:
+        f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
+        f.write(f"solve_seconds = {t_solve:.1f}\n")
+        f.write(f"n_omega = {len(omegas)}\nomega_min = {omegas.min()}\nomega_max = {omega_max}\n")
+        f.write(f"headings_deg = {list(map(float, p['headings_deg']))}\n")
+        for body in bodies:
+            f.write(f'[panels.{body.name}]\nhull = {body.mesh.nb_faces}\nlid = {body.lid_mesh.nb_faces}\n')
+    print(f"done in {time.time() - t0:.1f} s: {len(omegas)} frequencies, {len(p['headings_deg'])} headings, "
+          f"{nmodes} modes", flush=True)
+    # diagonal damping must be non-negative (irregular frequencies, coarse panels)
+    bd = ds["radiation_damping"]
+    for k, name in enumerate(dof_names):
+        v = np.asarray(bd.sel(radiating_dof=name, influenced_dof=name).values)
+        if (v < -1e-6 * max(1.0, np.abs(v).max())).any():
+            print(f"WARNING: negative damping on {name} at omega = {omegas[v < 0]}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
