@@ -4,6 +4,12 @@
 //! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`].
 //! Imperative shell: [`files`] (reading systems and databases from disk) and the `shipcast` binary.
 
+// Index loops read like the matrix formulas they implement (i, j, k as in the equations).
+#![allow(clippy::needless_range_loop)]
+
 pub mod files;
 pub mod hydro;
 pub mod rao;
+pub mod rom;
+pub mod scenario;
+pub mod waves;

@@ -8,6 +8,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use shipcast::files;
 use shipcast::hydro::check::{self, mode_label};
 use shipcast::rao::FrequencySolver;
+use shipcast::rom::regular::{RegularOptions, time_domain_rao};
+use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::scenario::{Scenario, prepare};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -32,6 +35,35 @@ enum Command {
     },
     /// Motion RAOs of a system as CSV on stdout: omega,heading_deg,mode,amplitude,phase_deg.
     Rao(RaoArgs),
+    /// Forecast a scenario (system, sea, speed, history, horizon); with --repeat, time it.
+    Forecast(ForecastArgs),
+}
+
+#[derive(Args, Debug)]
+struct ForecastArgs {
+    /// The scenario file (e.g. config/scenarios/two-ship.toml).
+    scenario: PathBuf,
+    /// Forecast horizon, s (default: the scenario's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Run the forecast N times and print the median and p95 wall time of one, as the last line.
+    #[arg(long, default_value_t = 1)]
+    repeat: usize,
+    /// Radiation memory (default: the scenario's).
+    #[arg(long, value_enum)]
+    radiation: Option<Radiation>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "csv")]
+    format: Format,
+    /// Write the forecast here instead of stdout.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Csv,
+    Json,
 }
 
 #[derive(Subcommand, Debug)]
@@ -53,6 +85,9 @@ enum Method {
     Frequency,
     /// Run the time-domain ROM in regular waves and fit the steady state.
     Time,
+    /// Solve the frequency domain of the time-domain model itself (A and B implied by its radiation
+    /// memory): the floor the time domain converges to.
+    Implied,
 }
 
 #[derive(Args, Debug)]
@@ -71,6 +106,29 @@ struct RaoArgs {
     /// Forward speed, m/s.
     #[arg(long, default_value_t = 0.0)]
     speed: f64,
+    /// Radiation memory of the time-domain model.
+    #[arg(long, value_enum, default_value = "convolution")]
+    radiation: Radiation,
+    /// Time step of the time-domain model, s.
+    #[arg(long, default_value_t = 0.1)]
+    dt: f64,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Radiation {
+    /// Direct convolution of the impulse response with the velocity history.
+    Convolution,
+    /// The passive state-space fit.
+    StateSpace,
+}
+
+impl From<Radiation> for RadiationMethod {
+    fn from(r: Radiation) -> Self {
+        match r {
+            Radiation::Convolution => RadiationMethod::Convolution,
+            Radiation::StateSpace => RadiationMethod::StateSpace,
+        }
+    }
 }
 
 /// Validated frequencies.
@@ -125,6 +183,7 @@ fn main() -> ExitCode {
             command: DbCommand::Check { system, all_pairs },
         } => db_check(&system, all_pairs),
         Command::Rao(args) => rao(&args),
+        Command::Forecast(args) => forecast(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -296,6 +355,17 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     if shown < kk.len() {
         writeln!(out, "  ... {} more pairs (--all-pairs)", kk.len() - shown)?;
     }
+    let t_fit = std::time::Instant::now();
+    let (ss, eb, ea) = check::state_space(sys, &report.a_inf);
+    writeln!(
+        out,
+        "state-space radiation (active DOFs): {} terms, {} states, fitted in {:.2} s; damping error {:.3} %, added mass error {:.3} % (largest, scaled)",
+        ss.terms.len(),
+        ss.n_states(),
+        t_fit.elapsed().as_secs_f64(),
+        100.0 * eb,
+        100.0 * ea
+    )?;
     let mut warnings = sys.warnings.clone();
     for (i, ws) in &report.negative_damping {
         let peak = db.damping.iter().map(|b| b[(*i, *i)]).fold(0.0, f64::max);
@@ -333,13 +403,103 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     Ok(())
 }
 
-fn rao(args: &RaoArgs) -> Result<()> {
-    if args.method == Method::Time {
-        bail!("--method time is not implemented yet (it comes with the time-domain ROM); use --method frequency");
+fn forecast(args: &ForecastArgs) -> Result<()> {
+    let mut sc = Scenario::load(&args.scenario)?;
+    if let Some(h) = args.horizon {
+        sc.horizon_s = h;
     }
-    if args.speed != 0.0 {
+    if let Some(r) = args.radiation {
+        sc.opts.radiation = r.into();
+    }
+    if args.repeat == 0 {
+        bail!("--repeat must be at least 1");
+    }
+    let loaded = files::load_system(&sc.system)?;
+    let sys = &loaded.system;
+    let t_build = std::time::Instant::now();
+    let model = TimeModel::new(sys, sc.opts).with_context(|| sc.system.display().to_string())?;
+    let build_s = t_build.elapsed().as_secs_f64();
+    let prep = prepare(&model, &sc.sea, sc.history_s).context("spin-up of the history")?;
+    let mut fc = Forecaster::new();
+    let req = ForecastRequest {
+        x0: &prep.x0,
+        v0: &prep.v0,
+        memory: &prep.memory,
+        waves: &prep.waves,
+        horizon_s: sc.horizon_s,
+        ramp_s: 0.0,
+    };
+    let mut times_ms = vec![];
+    for _ in 0..args.repeat {
+        let t = std::time::Instant::now();
+        fc.forecast(&model, &req)?;
+        times_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let f = fc.forecast(&model, &req)?;
+    let labels: Vec<String> = (0..sys.n_modes()).map(|i| mode_label(sys, i)).collect();
+    let mut text = String::new();
+    match args.format {
+        Format::Csv => {
+            text.push_str("t_s");
+            for l in &labels {
+                text.push(',');
+                text.push_str(l);
+            }
+            text.push('\n');
+            for k in 0..=f.steps {
+                text.push_str(&format!("{:.3}", k as f64 * f.dt_s));
+                for i in 0..f.n_modes {
+                    text.push_str(&format!(",{:.6e}", f.at(k, i)));
+                }
+                text.push('\n');
+            }
+        }
+        Format::Json => {
+            let series: Vec<String> = (0..f.n_modes)
+                .map(|i| {
+                    let v: Vec<String> = (0..=f.steps).map(|k| format!("{:.6e}", f.at(k, i))).collect();
+                    format!("\"{}\":[{}]", labels[i], v.join(","))
+                })
+                .collect();
+            text.push_str(&format!(
+                "{{\"dt_s\":{},\"horizon_s\":{},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{}}}}}\n",
+                f.dt_s,
+                f.steps as f64 * f.dt_s,
+                sc.opts.radiation,
+                f.skipped_components,
+                series.join(",")
+            ));
+        }
+    }
+    let mut out = std::io::stdout().lock();
+    match &args.out {
+        Some(p) => std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?,
+        None => out.write_all(text.as_bytes())?,
+    }
+    eprintln!(
+        "shipcast forecast: {} ({} active DOFs, {} wave components, {:?} radiation, memory {}), horizon {} s at dt {} s; model built in {:.2} s",
+        args.scenario.display(),
+        model.n(),
+        prep.waves.len(),
+        sc.opts.radiation,
+        model.memory_size(),
+        sc.horizon_s,
+        sc.opts.dt_s,
+        build_s
+    );
+    if args.repeat > 1 {
+        times_ms.sort_by(f64::total_cmp);
+        let median = times_ms[times_ms.len() / 2];
+        let p95 = times_ms[((times_ms.len() as f64 * 0.95).ceil() as usize).clamp(1, times_ms.len()) - 1];
+        writeln!(out, "forecast_ms_median={median:.3} forecast_ms_p95={p95:.3}")?;
+    }
+    Ok(())
+}
+
+fn rao(args: &RaoArgs) -> Result<()> {
+    if args.method != Method::Time && args.speed != 0.0 {
         bail!(
-            "--speed {}: the databases carry zero-speed data only; forward speed is not supported yet",
+            "--speed {}: the frequency-domain solver is for zero speed; use --method time",
             args.speed
         );
     }
@@ -366,15 +526,71 @@ fn rao(args: &RaoArgs) -> Result<()> {
         }
         None => sys.db.heading_rad.iter().map(|h| h.to_degrees()).collect(),
     };
-    let solver = FrequencySolver::new(sys);
+    let mut table: Vec<Vec<Vec<num_complex::Complex64>>> = vec![]; // [heading][omega][mode]
+    match args.method {
+        Method::Frequency => {
+            let solver = FrequencySolver::new(sys);
+            for &h in &headings_deg {
+                let mut rows = vec![];
+                for &w in &omegas {
+                    let xi = solver
+                        .rao(w, h.to_radians())
+                        .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?;
+                    rows.push(xi.iter().copied().collect());
+                }
+                table.push(rows);
+            }
+        }
+        Method::Implied => {
+            let opts = RomOptions {
+                dt_s: args.dt,
+                radiation: args.radiation.into(),
+                ..RomOptions::default()
+            };
+            let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
+            for &h in &headings_deg {
+                let mut rows = vec![];
+                for &w in &omegas {
+                    rows.push(
+                        model
+                            .implied_rao(w, h.to_radians())
+                            .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?,
+                    );
+                }
+                table.push(rows);
+            }
+        }
+        Method::Time => {
+            let t0 = std::time::Instant::now();
+            let opts = RomOptions {
+                dt_s: args.dt,
+                radiation: args.radiation.into(),
+                speed_m_s: args.speed,
+                ..RomOptions::default()
+            };
+            let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
+            for &h in &headings_deg {
+                let r = time_domain_rao(&model, h.to_radians(), &omegas, RegularOptions::default())
+                    .with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
+                tracing::info!(heading_deg = h, settled_s = r.settled_s, "steady state reached");
+                table.push(r.rao);
+            }
+            eprintln!(
+                "shipcast rao: time domain, {:?} radiation (memory {}), dt {} s: {} headings x {} frequencies in {:.2} s",
+                opts.radiation,
+                model.memory_size(),
+                opts.dt_s,
+                headings_deg.len(),
+                omegas.len(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
+    }
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     writeln!(out, "omega,heading_deg,mode,amplitude,phase_deg")?;
-    for &w in &omegas {
-        for &h in &headings_deg {
-            let xi = solver
-                .rao(w, h.to_radians())
-                .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?;
-            for (i, x) in xi.iter().enumerate() {
+    for (iw, &w) in omegas.iter().enumerate() {
+        for (ih, &h) in headings_deg.iter().enumerate() {
+            for (i, x) in table[ih][iw].iter().enumerate() {
                 writeln!(out, "{w},{h},{},{:.9e},{:.6}", i + 1, x.norm(), x.arg().to_degrees())?;
             }
         }

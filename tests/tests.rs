@@ -8,4 +8,5 @@ mod bad_input;
 mod capytaine_demo;
 mod core_purity;
 mod kramers_kronig;
+mod rom;
 mod wecsim_rm3;

@@ -2,6 +2,7 @@
 //! Kramers-Kronig consistency of A(w), B(w) and A_inf.
 
 use super::radiation::{self, Irf, PairError};
+use super::statespace;
 use super::system::AInfSource;
 use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
@@ -39,6 +40,26 @@ pub fn choose_a_inf(sys: &VesselSystem, irf: &Irf) -> (DMatrix<f64>, AInfSource)
             AInfSource::Ogilvie,
         ),
     }
+}
+
+/// The active DOFs' passive damping, added mass and A_inf (the inputs of the radiation models).
+pub fn active_radiation(
+    sys: &VesselSystem,
+    a_inf: &DMatrix<f64>,
+) -> (Vec<DMatrix<f64>>, Vec<DMatrix<f64>>, DMatrix<f64>) {
+    let act = sys.active_indices();
+    let sub = |m: &DMatrix<f64>| DMatrix::from_fn(act.len(), act.len(), |r, c| m[(act[r], act[c])]);
+    let b: Vec<DMatrix<f64>> = sys.db.damping.iter().map(sub).collect();
+    let (b, _) = radiation::passive_damping(&b);
+    (b, sys.db.added_mass.iter().map(sub).collect(), sub(a_inf))
+}
+
+/// The state-space fit of the active DOFs' radiation and its (damping, added mass) errors.
+pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> (statespace::SsModel, f64, f64) {
+    let (b, a, ai) = active_radiation(sys, a_inf);
+    let model = statespace::fit(&sys.db.omega_rad_s, &b, statespace::SsFitOptions::default());
+    let (eb, ea) = statespace::fit_errors(&model, &sys.db.omega_rad_s, &b, &a, &ai);
+    (model, eb, ea)
 }
 
 /// The IRF of a system with its configured (or default) time grid.

@@ -180,6 +180,13 @@ impl HydroDb {
 
     /// X(w, beta), bilinear in (w, beta) on real and imaginary parts.
     pub fn excitation_at(&self, omega_rad_s: f64, heading_rad: f64) -> Result<DVector<Complex64>> {
+        let mut out = DVector::from_element(self.n_modes, Complex64::default());
+        self.excitation_into(omega_rad_s, heading_rad, out.as_mut_slice())?;
+        Ok(out)
+    }
+
+    /// As [`Self::excitation_at`], into `out` (length n_modes): no allocation.
+    pub fn excitation_into(&self, omega_rad_s: f64, heading_rad: f64, out: &mut [Complex64]) -> Result<()> {
         let ws = &self.exc_omega_rad_s;
         let (iw, ww) = bracket(ws, omega_rad_s).ok_or_else(|| {
             Error::OutOfRange(format!(
@@ -193,10 +200,11 @@ impl HydroDb {
         let n = self.n_modes;
         let nb = self.heading_rad.len();
         let at = |w: usize, b: usize, i: usize| self.excitation[(w * nb + b) * n + i];
-        Ok(DVector::from_fn(n, |i, _| {
-            (at(iw, ib, i) * (1.0 - wb) + at(iw, jb, i) * wb) * (1.0 - ww)
-                + (at(jw, ib, i) * (1.0 - wb) + at(jw, jb, i) * wb) * ww
-        }))
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = (at(iw, ib, i) * (1.0 - wb) + at(iw, jb, i) * wb) * (1.0 - ww)
+                + (at(jw, ib, i) * (1.0 - wb) + at(jw, jb, i) * wb) * ww;
+        }
+        Ok(())
     }
 }
 

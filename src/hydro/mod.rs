@@ -17,6 +17,7 @@
 pub mod check;
 pub mod db;
 pub mod radiation;
+pub mod statespace;
 pub mod system;
 pub mod wamit;
 

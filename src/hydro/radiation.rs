@@ -94,15 +94,14 @@ impl Irf {
     }
 }
 
-/// The frequency nodes and damping values the IRF integrates: 0, the database, and the tail.
-fn damping_nodes(db: &HydroDb) -> (Vec<f64>, Vec<DMatrix<f64>>) {
-    let n = db.n_modes;
+/// The frequency nodes and damping values the IRF integrates: 0, the data, and the tail.
+fn damping_nodes(omegas: &[f64], damping: &[DMatrix<f64>], n: usize) -> (Vec<f64>, Vec<DMatrix<f64>>) {
     let mut w = vec![0.0];
     let mut b = vec![DMatrix::zeros(n, n)];
-    w.extend_from_slice(&db.omega_rad_s);
-    b.extend(db.damping.iter().cloned());
-    let wn = *db.omega_rad_s.last().unwrap_or(&1.0);
-    let bn = db.damping.last().cloned().unwrap_or_else(|| DMatrix::zeros(n, n));
+    w.extend_from_slice(omegas);
+    b.extend(damping.iter().cloned());
+    let wn = *omegas.last().unwrap_or(&1.0);
+    let bn = damping.last().cloned().unwrap_or_else(|| DMatrix::zeros(n, n));
     let mut x = wn * TAIL_NODE_RATIO;
     while x <= TAIL_END_FACTOR * wn {
         w.push(x);
@@ -110,6 +109,44 @@ fn damping_nodes(db: &HydroDb) -> (Vec<f64>, Vec<DMatrix<f64>>) {
         x *= TAIL_NODE_RATIO;
     }
     (w, b)
+}
+
+/// The database's damping made passive: at each frequency the symmetric part of B(w) is projected onto
+/// the positive semi-definite matrices (negative eigenvalues, from irregular frequencies or numerical
+/// noise, set to zero; eigen-decomposition in coordinates scaled by sqrt(max_w B_ii) so translations and
+/// rotations weigh alike). A passive B keeps every radiation model built from it from creating energy.
+/// Returns the damping and the largest change made, relative to the scale.
+pub fn passive_damping(damping: &[DMatrix<f64>]) -> (Vec<DMatrix<f64>>, f64) {
+    let Some(first) = damping.first() else {
+        return (vec![], 0.0);
+    };
+    let n = first.nrows();
+    let scale: Vec<f64> = (0..n)
+        .map(|i| {
+            damping
+                .iter()
+                .map(|b| b[(i, i)].abs())
+                .fold(0.0, f64::max)
+                .sqrt()
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    let out = damping
+        .iter()
+        .map(|b| {
+            let sym = DMatrix::from_fn(n, n, |i, j| 0.5 * (b[(i, j)] + b[(j, i)]) / (scale[i] * scale[j]));
+            let eig = sym.clone().symmetric_eigen();
+            if eig.eigenvalues.iter().all(|l| *l >= 0.0) {
+                return b.clone();
+            }
+            let clipped = eig.eigenvalues.map(|l| l.max(0.0));
+            let fixed = &eig.eigenvectors * DMatrix::from_diagonal(&clipped) * eig.eigenvectors.transpose();
+            worst = worst.max((&fixed - &sym).amax());
+            DMatrix::from_fn(n, n, |i, j| fixed[(i, j)] * scale[i] * scale[j])
+        })
+        .collect();
+    (out, worst)
 }
 
 /// Default memory length: pi / (smallest frequency spacing), clamped to 30..600 s.
@@ -137,10 +174,15 @@ fn unstack(m: &DMatrix<f64>, n: usize) -> Vec<DMatrix<f64>> {
         .collect()
 }
 
-/// K(t) on t = 0, dt, ..., duration.
+/// K(t) on t = 0, dt, ..., duration, from the database's damping as it is.
 pub fn impulse_response(db: &HydroDb, dt_s: f64, duration_s: f64) -> Irf {
-    let n = db.n_modes;
-    let (w, b) = damping_nodes(db);
+    impulse_response_of(&db.omega_rad_s, &db.damping, dt_s, duration_s)
+}
+
+/// K(t) on t = 0, dt, ..., duration from damping samples `damping[k]` at `omegas[k]` (ascending).
+pub fn impulse_response_of(omegas: &[f64], damping: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> Irf {
+    let n = damping.first().map(|b| b.nrows()).unwrap_or(0);
+    let (w, b) = damping_nodes(omegas, damping, n);
     let nt = (duration_s / dt_s).round() as usize + 1;
     let mut weights = DMatrix::zeros(nt, w.len());
     let mut row = vec![0.0; w.len()];

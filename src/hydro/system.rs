@@ -6,7 +6,8 @@
 //! Units: position m (BEM global frame); mass kg; centre_of_gravity m relative to the body's reference
 //! point (`position`); radii_of_gyration m about the centre of gravity (x, y, z axes); mass_matrix about
 //! the reference point (kg, kg m, kg m^2); linear damping N s/m, N s, N m s/rad by DOF pair; quadratic
-//! damping N s^2/m^2 ... (force per velocity squared).
+//! damping N s^2/m^2 ... (force per velocity squared); speed_damping (B_U) per m/s and speed_restoring
+//! (C_UQ) per (m/s)^2 of forward speed.
 
 use super::db::HydroDb;
 use super::wamit::{Excitation, Radiation};
@@ -79,6 +80,8 @@ struct BodyFile {
     radii_of_gyration: Option<[f64; 3]>,
     linear_damping: Option<[[f64; 6]; 6]>,
     quadratic_damping: Option<[[f64; 6]; 6]>,
+    speed_damping: Option<[[f64; 6]; 6]>,
+    speed_restoring: Option<[[f64; 6]; 6]>,
     active_dofs: Option<Vec<String>>,
 }
 
@@ -112,6 +115,10 @@ pub struct Body {
     pub linear_damping: Matrix6<f64>,
     /// B_Q in B_Q |x'| x'.
     pub quadratic_damping: Matrix6<f64>,
+    /// B_U in B_U U x' (damping per m/s of forward speed).
+    pub speed_damping: Matrix6<f64>,
+    /// C_UQ in C_UQ U^2 x (restoring per (m/s)^2 of forward speed).
+    pub speed_restoring: Matrix6<f64>,
     /// Which of surge..yaw are free.
     pub active: [bool; 6],
 }
@@ -334,10 +341,13 @@ fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
         Some(m) => finite_matrix(m, "linear_damping")?,
         None => Matrix6::zeros(),
     };
-    let quadratic_damping = match &b.quadratic_damping {
-        Some(m) => finite_matrix(m, "quadratic_damping")?,
-        None => Matrix6::zeros(),
+    let optional = |m: &Option<[[f64; 6]; 6]>, field: &str| match m {
+        Some(m) => finite_matrix(m, field),
+        None => Ok(Matrix6::zeros()),
     };
+    let quadratic_damping = optional(&b.quadratic_damping, "quadratic_damping")?;
+    let speed_damping = optional(&b.speed_damping, "speed_damping")?;
+    let speed_restoring = optional(&b.speed_restoring, "speed_restoring")?;
     let mut active = [true; 6];
     if let Some(list) = &b.active_dofs {
         active = [false; 6];
@@ -357,6 +367,8 @@ fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
         mass,
         linear_damping,
         quadratic_damping,
+        speed_damping,
+        speed_restoring,
         active,
     })
 }
@@ -418,6 +430,11 @@ impl VesselSystem {
     /// B_lin: the bodies' linear damping plus system-level entries.
     pub fn linear_damping(&self) -> DMatrix<f64> {
         self.block_diag(|b| &b.linear_damping) + &self.spec.extra_damping
+    }
+
+    /// Block-diagonal 6N x 6N matrix of a per-body 6x6 term.
+    pub fn body_matrix(&self, f: impl Fn(&Body) -> &Matrix6<f64>) -> DMatrix<f64> {
+        self.block_diag(f)
     }
 
     /// C: the database's restoring plus system-level stiffness entries.

@@ -126,7 +126,8 @@ PRESETS = {
     "ship": dict(
         stem="ship",
         bodies=[dict(name="carrier", hull="wigley", length=180.0, beam=30.0, draft=10.0,
-                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180))],
+                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180),
+                     roll_damping_ratio=0.05)],
         panel_m=3.0,
         omegas=np.round(np.arange(0.05, 1.6001, 0.025), 4),
         headings_deg=np.arange(0.0, 360.0, 30.0),
@@ -135,9 +136,11 @@ PRESETS = {
     "pair": dict(
         stem="pair",
         bodies=[dict(name="carrier", hull="wigley", length=180.0, beam=30.0, draft=10.0,
-                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180)),
+                     position=(0.0, 0.0, 0.0), kg_m=11.0, radii=(0.35 * 30, 0.25 * 180, 0.26 * 180),
+                     roll_damping_ratio=0.05),
                 dict(name="lighter", hull="wigley", length=120.0, beam=20.0, draft=7.0,
-                     position=(0.0, 30.0, 0.0), kg_m=7.5, radii=(0.35 * 20, 0.25 * 120, 0.26 * 120))],
+                     position=(0.0, 30.0, 0.0), kg_m=7.5, radii=(0.35 * 20, 0.25 * 120, 0.26 * 120),
+                     roll_damping_ratio=0.05)],
         panel_m=3.0,
         # gap resonances live between about 0.8 and 1.6 rad/s: sample them at 0.005 rad/s
         omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6001, 0.005)]), 4),
@@ -198,7 +201,24 @@ def main():
     cmat = np.asarray(system.hydrostatic_stiffness)
     ds["inertia_matrix"] = system.inertia_matrix
     ds["hydrostatic_stiffness"] = system.hydrostatic_stiffness
-    rao = cpt.post_pro.rao(ds)
+    # Viscous roll damping (potential flow alone leaves ship roll almost undamped, 0.1 % of critical here):
+    # a linear B44 giving `roll_damping_ratio` of critical at each body's roll natural frequency. Written
+    # to system.toml as linear_damping and passed to Capytaine's RAO as dissipation, so both agree.
+    dissipation = np.zeros((nmodes, nmodes))
+    roll_b44 = []
+    for k, spec in enumerate(p["bodies"]):
+        i = 6 * k + 3
+        am = ds["added_mass"].sel(radiating_dof=dof_names[i], influenced_dof=dof_names[i]).values
+        w = math.sqrt(cmat[i, i] / mmat[i, i])
+        for _ in range(50):
+            a44 = float(np.interp(w, omegas, am))
+            w = 0.5 * w + 0.5 * math.sqrt(cmat[i, i] / (mmat[i, i] + a44))
+        a44 = float(np.interp(w, omegas, am))
+        b44 = 2.0 * spec.get("roll_damping_ratio", 0.0) * math.sqrt(cmat[i, i] * (mmat[i, i] + a44))
+        dissipation[i, i] = b44
+        roll_b44.append(b44)
+        print(f"{spec['name']}: roll natural frequency {w:.4f} rad/s, linear roll damping {b44:.4e} N m s/rad", flush=True)
+    rao = cpt.post_pro.rao(ds, dissipation=system.add_dofs_labels_to_matrix(dissipation))
 
     def sel(da, **kw):
         return np.asarray(da.sel(**kw).squeeze().values)
@@ -260,6 +280,12 @@ def main():
             rel = cog - pos
             f.write(f"centre_of_gravity = [{rel[0]:.9g}, {rel[1]:.9g}, {rel[2]:.9g}]   # relative to position\n")
             f.write(f"radii_of_gyration = [{spec['radii'][0]:.9g}, {spec['radii'][1]:.9g}, {spec['radii'][2]:.9g}]\n")
+            b44 = roll_b44[p["bodies"].index(spec)]
+            if b44 > 0.0:
+                f.write(f"# viscous roll damping: {spec['roll_damping_ratio']:.0%} of critical at the roll natural frequency\n")
+                rows = [[0.0] * 6 for _ in range(6)]
+                rows[3][3] = b44
+                f.write("linear_damping = [\n" + "".join(f"    [{', '.join(f'{v:.9e}' for v in r)}],\n" for r in rows) + "]\n")
     with open(os.path.join(args.outdir, "bem_info.toml"), "w") as f:
         f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
         f.write(f"solve_seconds = {t_solve:.1f}\n")

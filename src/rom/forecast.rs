@@ -1,0 +1,323 @@
+//! The forecaster: state and history in, motion out (pure; no clock, no IO). A repeated forecast of
+//! the same size allocates nothing: the workspace is kept between calls (rapier's habit).
+
+use super::memory::Memory;
+use super::model::{Kernel, TimeModel};
+use super::stepper::Stepper;
+use super::{Error, Result};
+use crate::waves::{WaveComponent, encounter_frequency, wave_number};
+use num_complex::Complex64;
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+/// What a forecast needs, for the active DOFs of the model (in `model.active` order).
+#[derive(Debug, Clone, Copy)]
+pub struct ForecastRequest<'a> {
+    /// Displacements at t0, m or rad.
+    pub x0: &'a [f64],
+    /// Velocities at t0, m/s or rad/s.
+    pub v0: &'a [f64],
+    /// The velocities before t0 (see [`Memory`]).
+    pub memory: &'a Memory,
+    /// Wave components in the seakeeping frame, amplitudes at the origin at t0.
+    pub waves: &'a [WaveComponent],
+    /// Forecast length, s.
+    pub horizon_s: f64,
+    /// Optional ramp of the wave force over its first seconds (regular-wave runs), s; 0 = none.
+    pub ramp_s: f64,
+}
+
+/// A forecast: every mode (inactive ones zero) on t = t0 + k dt, k = 0..steps.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Forecast {
+    pub dt_s: f64,
+    pub n_modes: usize,
+    pub steps: usize,
+    /// x[k * n_modes + i], m or rad.
+    pub x: Vec<f64>,
+    /// v[k * n_modes + i], m/s or rad/s.
+    pub v: Vec<f64>,
+    /// Components outside the database (frequency or heading) and left out.
+    pub skipped_components: usize,
+    /// Their share of the field's variance, sum |a|^2 / 2.
+    pub skipped_variance_fraction: f64,
+}
+
+impl Forecast {
+    pub fn at(&self, k: usize, mode: usize) -> f64 {
+        self.x[k * self.n_modes + mode]
+    }
+}
+
+/// Reusable forecasting workspace for one model.
+pub struct Forecaster {
+    stepper: Stepper,
+    out: Forecast,
+    force: Vec<f64>,
+    known: Vec<f64>,
+    // wave recurrence, laid out for vectorization over components
+    cr: Vec<f64>,
+    ci: Vec<f64>,
+    zr: Vec<f64>,
+    zi: Vec<f64>,
+    rr: Vec<f64>,
+    ri: Vec<f64>,
+    xbuf: Vec<Complex64>,
+    // FFT of the kernel (convolution with a history), built on first use
+    fft: Option<HistoryFft>,
+}
+
+struct HistoryFft {
+    len: usize,
+    forward: Arc<dyn Fft<f64>>,
+    inverse: Arc<dyn Fft<f64>>,
+    /// K-hat[(i * n + j) * len + f]
+    kernel: Vec<Complex64>,
+    u: Vec<Complex64>,
+    acc: Vec<Complex64>,
+    scratch: Vec<Complex64>,
+}
+
+impl Default for Forecaster {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Forecaster {
+    pub fn new() -> Self {
+        Forecaster {
+            stepper: Stepper::new(),
+            out: Forecast::default(),
+            force: vec![],
+            known: vec![],
+            cr: vec![],
+            ci: vec![],
+            zr: vec![],
+            zi: vec![],
+            rr: vec![],
+            ri: vec![],
+            xbuf: vec![],
+            fft: None,
+        }
+    }
+
+    /// Runs one forecast. Errors: inputs that do not fit the model; a state that diverges (which DOF,
+    /// when): never NaN to the caller.
+    pub fn forecast(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<&Forecast> {
+        let n = model.n();
+        let dt = model.opts.dt_s;
+        if !(req.horizon_s.is_finite() && req.horizon_s > 0.0 && req.horizon_s <= 86_400.0) {
+            return Err(Error::Input(format!(
+                "horizon {} s: must be in (0, 86400] s",
+                req.horizon_s
+            )));
+        }
+        let steps = (req.horizon_s / dt).round() as usize;
+        self.wave_force(model, req.waves, steps, req.ramp_s)?;
+        self.known.clear();
+        self.known.resize((steps + 1) * n, 0.0);
+        if let (Kernel::Convolution { .. }, Memory::Convolution { len, .. }) = (&model.kernel, req.memory)
+            && (*len > 0 || req.v0.iter().any(|v| *v != 0.0))
+        {
+            self.history_part(model, req.v0, req.memory, steps)?;
+        }
+        let f0: Vec<f64> = self.force[..n].to_vec();
+        self.stepper.start(model, req.x0, req.v0, req.memory, steps, &f0)?;
+        let nm = model.n_modes;
+        self.out.dt_s = dt;
+        self.out.n_modes = nm;
+        self.out.steps = steps;
+        self.out.x.clear();
+        self.out.x.resize((steps + 1) * nm, 0.0);
+        self.out.v.clear();
+        self.out.v.resize((steps + 1) * nm, 0.0);
+        for (r, &i) in model.active.iter().enumerate() {
+            self.out.x[i] = req.x0[r];
+            self.out.v[i] = req.v0[r];
+        }
+        for k in 1..=steps {
+            let f = &self.force[k * n..(k + 1) * n];
+            let kn = &self.known[k * n..(k + 1) * n];
+            self.stepper.step(model, f, kn)?;
+            for (r, &i) in model.active.iter().enumerate() {
+                self.out.x[k * nm + i] = self.stepper.x[r];
+                self.out.v[k * nm + i] = self.stepper.v[r];
+            }
+        }
+        Ok(&self.out)
+    }
+
+    /// The wave force a request implies at t0 + k dt, k = 0..steps (k-major, active DOFs), through the
+    /// same code as a forecast.
+    pub fn force_for(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<Vec<f64>> {
+        let steps = (req.horizon_s / model.opts.dt_s).round() as usize;
+        self.wave_force(model, req.waves, steps, req.ramp_s)?;
+        Ok(self.force.clone())
+    }
+
+    /// Components of the last request left out (outside the database).
+    pub fn skipped(&self) -> usize {
+        self.out.skipped_components
+    }
+
+    /// F_wave at t0 + k dt for k = 0..steps: sum over components of Re{X a exp(i w_e t)}.
+    fn wave_force(&mut self, model: &TimeModel, waves: &[WaveComponent], steps: usize, ramp_s: f64) -> Result<()> {
+        let n = model.n();
+        let dt = model.opts.dt_s;
+        let u = model.opts.speed_m_s;
+        self.cr.clear();
+        self.ci.clear();
+        self.zr.clear();
+        self.zi.clear();
+        self.rr.clear();
+        self.ri.clear();
+        self.xbuf.resize(model.n_modes, Complex64::default());
+        let mut kept = vec![];
+        let (mut total, mut skipped) = (0.0, 0.0);
+        self.out.skipped_components = 0;
+        for w in waves {
+            if !(w.omega_rad_s.is_finite()
+                && w.omega_rad_s > 0.0
+                && w.heading_rad.is_finite()
+                && w.amplitude_m.re.is_finite()
+                && w.amplitude_m.im.is_finite())
+            {
+                return Err(Error::Input(format!(
+                    "wave component {w:?}: frequency must be positive and every value finite"
+                )));
+            }
+            let var = 0.5 * w.amplitude_m.norm_sqr();
+            total += var;
+            if model
+                .db
+                .excitation_into(w.omega_rad_s, w.heading_rad, &mut self.xbuf)
+                .is_err()
+            {
+                skipped += var;
+                self.out.skipped_components += 1;
+                continue;
+            }
+            let k = wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m);
+            let we = encounter_frequency(w.omega_rad_s, k, u, w.heading_rad);
+            kept.push((
+                we,
+                model
+                    .active
+                    .iter()
+                    .map(|&i| self.xbuf[i] * w.amplitude_m)
+                    .collect::<Vec<_>>(),
+            ));
+        }
+        self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
+        let nc = kept.len();
+        self.cr.resize(n * nc, 0.0);
+        self.ci.resize(n * nc, 0.0);
+        for (c, (we, x)) in kept.iter().enumerate() {
+            for i in 0..n {
+                self.cr[i * nc + c] = x[i].re;
+                self.ci[i * nc + c] = x[i].im;
+            }
+            self.zr.push(1.0);
+            self.zi.push(0.0);
+            let (s, co) = (we * dt).sin_cos();
+            self.rr.push(co);
+            self.ri.push(s);
+        }
+        self.force.clear();
+        self.force.resize((steps + 1) * n, 0.0);
+        for k in 0..=steps {
+            let t = k as f64 * dt;
+            let ramp = if ramp_s > 0.0 && t < ramp_s {
+                0.5 * (1.0 - (std::f64::consts::PI * t / ramp_s).cos())
+            } else {
+                1.0
+            };
+            for i in 0..n {
+                let cr = &self.cr[i * nc..(i + 1) * nc];
+                let ci = &self.ci[i * nc..(i + 1) * nc];
+                self.force[k * n + i] = ramp * (super::stepper::dot(cr, &self.zr) - super::stepper::dot(ci, &self.zi));
+            }
+            for c in 0..nc {
+                let (zr, zi) = (self.zr[c], self.zi[c]);
+                self.zr[c] = zr * self.rr[c] - zi * self.ri[c];
+                self.zi[c] = zr * self.ri[c] + zi * self.rr[c];
+            }
+        }
+        Ok(())
+    }
+
+    /// The radiation force from the velocities up to t0 (history and v0) at every step, by FFT:
+    /// P[k] = sum_{m >= k} K~_m v_{k-m}.
+    fn history_part(&mut self, model: &TimeModel, v0: &[f64], memory: &Memory, steps: usize) -> Result<()> {
+        let Kernel::Convolution { taps, k } = &model.kernel else {
+            return Ok(());
+        };
+        let (taps, n) = (*taps, model.n());
+        let len = (2 * taps).next_power_of_two();
+        if self
+            .fft
+            .as_ref()
+            .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
+        {
+            let mut planner = FftPlanner::new();
+            let forward = planner.plan_fft_forward(len);
+            let inverse = planner.plan_fft_inverse(len);
+            let mut kernel = vec![Complex64::default(); n * n * len];
+            let mut scratch =
+                vec![Complex64::default(); forward.get_inplace_scratch_len().max(inverse.get_inplace_scratch_len())];
+            for i in 0..n {
+                for j in 0..n {
+                    let s = &mut kernel[(i * n + j) * len..(i * n + j + 1) * len];
+                    for m in 0..taps {
+                        s[m] = Complex64::new(k[(i * taps + m) * n + j], 0.0);
+                    }
+                    forward.process_with_scratch(s, &mut scratch);
+                }
+            }
+            self.fft = Some(HistoryFft {
+                len,
+                forward,
+                inverse,
+                kernel,
+                u: vec![Complex64::default(); n * len],
+                acc: vec![Complex64::default(); len],
+                scratch,
+            });
+        }
+        let Some(f) = self.fft.as_mut() else { return Ok(()) };
+        // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0
+        let mut tmp = vec![0.0; n];
+        f.u.iter_mut().for_each(|c| *c = Complex64::default());
+        for m in 0..taps {
+            if m == 0 {
+                tmp.copy_from_slice(v0);
+            } else {
+                memory.velocity_ago(m - 1, n, &mut tmp);
+            }
+            for j in 0..n {
+                f.u[j * len + taps - 1 - m] = Complex64::new(tmp[j], 0.0);
+            }
+        }
+        for j in 0..n {
+            f.forward
+                .process_with_scratch(&mut f.u[j * len..(j + 1) * len], &mut f.scratch);
+        }
+        let scale = 1.0 / len as f64;
+        for i in 0..n {
+            f.acc.iter_mut().for_each(|c| *c = Complex64::default());
+            for j in 0..n {
+                let kh = &f.kernel[(i * n + j) * len..(i * n + j + 1) * len];
+                let uh = &f.u[j * len..(j + 1) * len];
+                for ((a, kk), uu) in f.acc.iter_mut().zip(kh).zip(uh) {
+                    *a += kk * uu;
+                }
+            }
+            f.inverse.process_with_scratch(&mut f.acc, &mut f.scratch);
+            for kk in 1..=steps.min(taps - 1) {
+                self.known[kk * n + i] = f.acc[kk + taps - 1].re * scale;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,140 @@
+//! Radiation memory state: what the model needs of the past velocities (pure).
+//!
+//! Convolution: the last `taps` velocity samples at the solver step (newest last). State space: the
+//! states of every term and DOF after the newest sample, and that sample. Either is built sample by
+//! sample with [`Memory::push`] (the daemon does this as measurements arrive, once per sample) or from a
+//! whole history with [`Memory::from_history`].
+
+use super::model::{Kernel, TimeModel};
+use super::{Error, Result};
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Memory {
+    Convolution {
+        /// Ring buffer of velocities, `taps` x n, `head` is the slot of the next sample.
+        ring: Vec<f64>,
+        head: usize,
+        len: usize,
+    },
+    StateSpace {
+        /// For term k and DOF j, `order_k` states, concatenated term by term, DOF by DOF.
+        states: Vec<f64>,
+        last_v: Vec<f64>,
+        started: bool,
+    },
+}
+
+impl Memory {
+    /// At rest: no past motion.
+    pub fn new(model: &TimeModel) -> Memory {
+        let n = model.n();
+        match &model.kernel {
+            Kernel::Convolution { taps, .. } => Memory::Convolution {
+                ring: vec![0.0; taps * n],
+                head: 0,
+                len: 0,
+            },
+            Kernel::StateSpace { discrete, .. } => Memory::StateSpace {
+                states: vec![0.0; n * discrete.iter().map(|d| d.order).sum::<usize>()],
+                last_v: vec![0.0; n],
+                started: false,
+            },
+        }
+    }
+
+    /// Velocities sampled at the model's dt, oldest first, the last one at the forecast start.
+    pub fn from_history(model: &TimeModel, velocities: &[Vec<f64>]) -> Result<Memory> {
+        let mut m = Memory::new(model);
+        for v in velocities {
+            m.push(model, v)?;
+        }
+        Ok(m)
+    }
+
+    /// Appends one velocity sample (active DOFs, m/s or rad/s), one step after the previous.
+    pub fn push(&mut self, model: &TimeModel, v: &[f64]) -> Result<()> {
+        let n = model.n();
+        if v.len() != n {
+            return Err(Error::Input(format!(
+                "velocity sample has {} values, the model {} active DOFs",
+                v.len(),
+                n
+            )));
+        }
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(Error::Input(format!("velocity of {} is not finite", model.labels[i])));
+        }
+        match (self, &model.kernel) {
+            (Memory::Convolution { ring, head, len }, Kernel::Convolution { taps, .. }) => {
+                ring[*head * n..(*head + 1) * n].copy_from_slice(v);
+                *head = (*head + 1) % taps;
+                *len = (*len + 1).min(*taps);
+            }
+            (
+                Memory::StateSpace {
+                    states,
+                    last_v,
+                    started,
+                },
+                Kernel::StateSpace { discrete, .. },
+            ) => {
+                if *started {
+                    advance_states(discrete, states, last_v, v, n);
+                }
+                last_v.copy_from_slice(v);
+                *started = true;
+            }
+            _ => return Err(Error::Input("memory and model use different radiation methods".into())),
+        }
+        Ok(())
+    }
+
+    /// The velocity `m` samples before the newest (m = 0: the newest), zero before the first.
+    pub fn velocity_ago(&self, m: usize, n: usize, out: &mut [f64]) {
+        match self {
+            Memory::Convolution { ring, head, len } => {
+                let taps = ring.len() / n.max(1);
+                if m >= *len || taps == 0 {
+                    out.iter_mut().for_each(|x| *x = 0.0);
+                } else {
+                    let slot = (head + taps - 1 - m) % taps;
+                    out.copy_from_slice(&ring[slot * n..(slot + 1) * n]);
+                }
+            }
+            Memory::StateSpace { last_v, started, .. } => {
+                if m == 0 && *started {
+                    out.copy_from_slice(last_v);
+                } else {
+                    out.iter_mut().for_each(|x| *x = 0.0);
+                }
+            }
+        }
+    }
+}
+
+/// Exact first-order-hold update of every term's states from velocity `v0` to `v1` over one step.
+pub(crate) fn advance_states(
+    discrete: &[crate::hydro::statespace::DiscreteTerm],
+    states: &mut [f64],
+    v0: &[f64],
+    v1: &[f64],
+    n: usize,
+) {
+    let mut off = 0;
+    let mut tmp = [0.0f64; 8];
+    for d in discrete {
+        let m = d.order;
+        for j in 0..n {
+            let x = &mut states[off..off + m];
+            for r in 0..m {
+                let mut acc = d.gamma0[r] * v0[j] + d.gamma1[r] * v1[j];
+                for c in 0..m {
+                    acc += d.phi[r * m + c] * x[c];
+                }
+                tmp[r] = acc;
+            }
+            x.copy_from_slice(&tmp[..m]);
+            off += m;
+        }
+    }
+}

@@ -1,0 +1,50 @@
+//! The reduced-order model: the generalized Cummins equations of N vessels in the time domain (pure).
+//!
+//! Equation of motion (DESIGN.md section 1, seed paper eq. 2), over the active DOFs:
+//!   (M + A_inf) x'' + (B_lin + B_U U) x' + B_Q |x'| x' + (C + C_UQ U^2) x + int_0^T K(tau) x'(t - tau) dtau
+//!       = F_wave(t)
+//! Conventions: SI units; DOF order surge..yaw per vessel (vessel k owns 6k..6k+5); inactive DOFs are
+//! held at zero; K(t) from the database's damping made passive ([`crate::hydro::radiation`]); A_inf by
+//! Ogilvie's relation from that same K (consistent with it), or the database's when the system file says
+//! `a_inf = "database"`. Zero-speed database: K and X are those at U = 0, the
+//! forcing runs at the encounter frequency.
+//!
+//! Time integration ([`stepper`]): Newmark's method with gamma = 1/2 and a chosen beta (1/4: average
+//! acceleration, unconditionally stable, second order; 1/12: Fox-Goodwin, fourth order in the period for
+//! the undamped part, stable for w dt < 2.45), fixed step dt. The radiation force at the new step is
+//! split into what is known (history) and an instantaneous part D v_{k+1} folded into the implicit
+//! matrix, so one radiation evaluation per step suffices and nothing is frozen. Nonlinear forces
+//! (quadratic damping) are evaluated at a predicted state and corrected once.
+//!
+//! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
+//! reference) or the passive state-space fit ([`crate::hydro::statespace`]) with its exact discrete
+//! update.
+
+pub mod forecast;
+pub mod memory;
+pub mod model;
+pub mod regular;
+pub mod stepper;
+
+pub use forecast::{Forecast, ForecastRequest, Forecaster};
+pub use memory::Memory;
+pub use model::{RadiationMethod, RomOptions, TimeModel};
+
+/// Errors of the time-domain model.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// The state went non-finite or beyond the bound: which DOF, when.
+    #[error("the motion of {dof} became {what} at t = {time_s:.3} s after the start: forecast abandoned")]
+    Diverged {
+        dof: String,
+        time_s: f64,
+        what: &'static str,
+    },
+    /// An input does not fit the model (sizes, non-finite values, options).
+    #[error("{0}")]
+    Input(String),
+    #[error(transparent)]
+    Hydro(#[from] crate::hydro::Error),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;

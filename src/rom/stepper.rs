@@ -1,0 +1,321 @@
+//! One time step of the Cummins equations, Newmark (gamma = 1/2, beta from the options), with the
+//! radiation force split into a known part and an implicit instantaneous part (see [`super`]).
+//! The stepper owns only reusable workspace; what it reads comes in as arguments.
+
+use super::memory::{Memory, advance_states};
+use super::model::{Kernel, TimeModel};
+use super::{Error, Result};
+
+/// Displacement beyond which a state counts as unbounded (m or rad).
+pub const UNBOUNDED: f64 = 1.0e4;
+
+/// Workspace and current state of a run.
+#[derive(Debug, Clone, Default)]
+pub struct Stepper {
+    n: usize,
+    /// Steps the buffers are sized for.
+    capacity: usize,
+    pub x: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    /// Index of the current step (0 at the start).
+    pub k: usize,
+    /// Convolution: velocities in reverse time order; v_k at (capacity - k) n, history after v_0.
+    buf: Vec<f64>,
+    /// State space: term states.
+    states: Vec<f64>,
+    // scratch
+    xt: Vec<f64>,
+    vt: Vec<f64>,
+    rhs: Vec<f64>,
+    p: Vec<f64>,
+    fnl: Vec<f64>,
+    y: Vec<f64>,
+    a_new: Vec<f64>,
+    v_new: Vec<f64>,
+    v_pred: Vec<f64>,
+}
+
+impl Stepper {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sizes the workspace for `steps` steps (reallocates only when it grows).
+    fn reserve(&mut self, model: &TimeModel, steps: usize) {
+        let n = model.n();
+        let taps = match &model.kernel {
+            Kernel::Convolution { taps, .. } => *taps,
+            Kernel::StateSpace { .. } => 0,
+        };
+        if self.n != n || self.capacity < steps {
+            self.n = n;
+            self.capacity = steps;
+            for v in [
+                &mut self.x,
+                &mut self.v,
+                &mut self.a,
+                &mut self.xt,
+                &mut self.vt,
+                &mut self.rhs,
+                &mut self.p,
+                &mut self.fnl,
+                &mut self.a_new,
+                &mut self.v_new,
+                &mut self.v_pred,
+            ] {
+                v.resize(n, 0.0);
+            }
+            self.buf = vec![0.0; if taps > 0 { (steps + taps) * n } else { 0 }];
+        }
+        if let Kernel::StateSpace { discrete, .. } = &model.kernel {
+            self.states
+                .resize(n * discrete.iter().map(|d| d.order).sum::<usize>(), 0.0);
+            self.y.resize(n * discrete.len(), 0.0);
+        }
+    }
+
+    fn pos(&self, k: isize) -> usize {
+        ((self.capacity as isize - k) as usize) * self.n
+    }
+
+    /// Starts a run of up to `steps` steps from (x0, v0) at t0 with the memory of the velocities before
+    /// t0; `f0` is the wave force at t0.
+    pub fn start(
+        &mut self,
+        model: &TimeModel,
+        x0: &[f64],
+        v0: &[f64],
+        memory: &Memory,
+        steps: usize,
+        f0: &[f64],
+    ) -> Result<()> {
+        let n = model.n();
+        if x0.len() != n || v0.len() != n {
+            return Err(Error::Input(format!(
+                "initial state has {} / {} values, the model {n} active DOFs",
+                x0.len(),
+                v0.len()
+            )));
+        }
+        if let Some(i) = x0.iter().chain(v0).position(|x| !x.is_finite()) {
+            return Err(Error::Input(format!(
+                "initial state of {} is not finite",
+                model.labels[i % n]
+            )));
+        }
+        self.reserve(model, steps);
+        self.k = 0;
+        self.x.copy_from_slice(x0);
+        self.v.copy_from_slice(v0);
+        // radiation force at t0
+        let mut frad = vec![0.0; n];
+        match (&model.kernel, memory) {
+            (Kernel::Convolution { taps, k }, Memory::Convolution { .. }) => {
+                let p0 = self.pos(0);
+                self.buf[p0..p0 + n].copy_from_slice(v0);
+                for m in 1..*taps {
+                    let at = p0 + m * n;
+                    memory.velocity_ago(m - 1, n, &mut self.buf[at..at + n]);
+                }
+                for (i, f) in frad.iter_mut().enumerate() {
+                    let row = &k[i * taps * n..(i + 1) * taps * n];
+                    *f = dot(row, &self.buf[p0..p0 + taps * n]);
+                }
+            }
+            (
+                Kernel::StateSpace {
+                    model: ss, discrete, ..
+                },
+                Memory::StateSpace {
+                    states,
+                    last_v,
+                    started,
+                },
+            ) => {
+                self.states.copy_from_slice(states);
+                if *started {
+                    advance_states(discrete, &mut self.states, last_v, v0, n);
+                }
+                let mut off = 0;
+                for (t, d) in ss.terms.iter().zip(discrete) {
+                    for j in 0..n {
+                        let yj: f64 =
+                            d.c.iter()
+                                .zip(&self.states[off..off + d.order])
+                                .map(|(c, x)| c * x)
+                                .sum();
+                        for (i, f) in frad.iter_mut().enumerate() {
+                            *f += t.gain[(i, j)] * yj;
+                        }
+                        off += d.order;
+                    }
+                }
+            }
+            _ => return Err(Error::Input("memory and model use different radiation methods".into())),
+        }
+        self.nonlinear(model, true);
+        // M a0 = F - B v - C x - F_nl - F_rad
+        for i in 0..n {
+            let mut r = f0[i] - frad[i] - self.fnl[i];
+            for j in 0..n {
+                r -= model.damping[(i, j)] * v0[j] + model.stiffness[(i, j)] * x0[j];
+            }
+            self.rhs[i] = r;
+        }
+        let m_inv = model
+            .mass
+            .clone()
+            .try_inverse()
+            .ok_or_else(|| Error::Input("singular mass matrix".into()))?;
+        for i in 0..n {
+            self.a[i] = (0..n).map(|j| m_inv[(i, j)] * self.rhs[j]).sum();
+        }
+        Ok(())
+    }
+
+    /// Quadratic damping at (x, v) when `current`, else at the predicted state (xt, vt).
+    fn nonlinear(&mut self, model: &TimeModel, current: bool) {
+        let n = self.n;
+        self.fnl.iter_mut().for_each(|f| *f = 0.0);
+        if let Some(q) = &model.quadratic {
+            let v = if current { &self.v } else { &self.vt };
+            for i in 0..n {
+                self.fnl[i] = (0..n).map(|j| q[(i, j)] * v[j].abs() * v[j]).sum();
+            }
+        }
+    }
+
+    /// Advances one step with the wave force `f1` at the new time and the known radiation part `known`
+    /// (history before t0; zero when there is none).
+    pub fn step(&mut self, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
+        let n = self.n;
+        let dt = model.opts.dt_s;
+        let beta = model.opts.beta;
+        let k1 = self.k + 1;
+        if k1 > self.capacity {
+            return Err(Error::Input("stepper capacity exceeded".into()));
+        }
+        // radiation: known part P
+        match &model.kernel {
+            Kernel::Convolution { taps, k } => {
+                let mcount = (k1 - 1).min(taps - 1);
+                let start = self.pos(k1 as isize - 1);
+                for i in 0..n {
+                    let row = &k[(i * taps + 1) * n..(i * taps + 1 + mcount) * n];
+                    self.p[i] = known[i] + dot(row, &self.buf[start..start + mcount * n]);
+                }
+            }
+            Kernel::StateSpace {
+                model: ss,
+                discrete,
+                c_phi,
+                c_g0,
+                ..
+            } => {
+                let mut off = 0;
+                for (kt, d) in discrete.iter().enumerate() {
+                    for j in 0..n {
+                        let x = &self.states[off..off + d.order];
+                        self.y[kt * n + j] =
+                            c_phi[kt].iter().zip(x).map(|(c, s)| c * s).sum::<f64>() + c_g0[kt] * self.v[j];
+                        off += d.order;
+                    }
+                }
+                self.p.iter_mut().for_each(|p| *p = 0.0);
+                for (kt, t) in ss.terms.iter().enumerate() {
+                    let y = &self.y[kt * n..(kt + 1) * n];
+                    for j in 0..n {
+                        let yj = y[j];
+                        if yj != 0.0 {
+                            for i in 0..n {
+                                self.p[i] += t.gain[(i, j)] * yj;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // predictor
+        for i in 0..n {
+            self.xt[i] = self.x[i] + dt * self.v[i] + dt * dt * (0.5 - beta) * self.a[i];
+            self.vt[i] = self.v[i] + 0.5 * dt * self.a[i];
+        }
+        let passes = if model.quadratic.is_some() { 2 } else { 1 };
+        for pass in 0..passes {
+            if let Some(q) = &model.quadratic {
+                // quadratic damping at the predicted velocity: first with a_{k+1} = a_k, then corrected
+                let a_guess = if pass == 0 { &self.a } else { &self.a_new };
+                for i in 0..n {
+                    self.v_pred[i] = self.vt[i] + 0.5 * dt * a_guess[i];
+                }
+                for i in 0..n {
+                    self.fnl[i] = (0..n).map(|j| q[(i, j)] * self.v_pred[j].abs() * self.v_pred[j]).sum();
+                }
+            }
+            for i in 0..n {
+                let mut r = f1[i] - self.p[i] - self.fnl[i];
+                for j in 0..n {
+                    r -= (model.damping[(i, j)] + model.d_inst[(i, j)]) * self.vt[j]
+                        + model.stiffness[(i, j)] * self.xt[j];
+                }
+                self.rhs[i] = r;
+            }
+            for i in 0..n {
+                self.a_new[i] = (0..n).map(|j| model.s_inv[(i, j)] * self.rhs[j]).sum();
+            }
+        }
+        for i in 0..n {
+            self.x[i] = self.xt[i] + beta * dt * dt * self.a_new[i];
+            self.v_new[i] = self.vt[i] + 0.5 * dt * self.a_new[i];
+            self.a[i] = self.a_new[i];
+        }
+        // memory
+        match &model.kernel {
+            Kernel::Convolution { .. } => {
+                let p = self.pos(k1 as isize);
+                self.buf[p..p + n].copy_from_slice(&self.v_new);
+            }
+            Kernel::StateSpace { discrete, .. } => advance_states(discrete, &mut self.states, &self.v, &self.v_new, n),
+        }
+        std::mem::swap(&mut self.v, &mut self.v_new);
+        self.k = k1;
+        for i in 0..n {
+            let (x, v) = (self.x[i], self.v[i]);
+            if !(x.is_finite() && v.is_finite()) {
+                return Err(Error::Diverged {
+                    dof: model.labels[i].clone(),
+                    time_s: k1 as f64 * dt,
+                    what: "non-finite",
+                });
+            }
+            if x.abs() > UNBOUNDED {
+                return Err(Error::Diverged {
+                    dof: model.labels[i].clone(),
+                    time_s: k1 as f64 * dt,
+                    what: "unbounded (beyond 1e4 m or rad)",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Dot product with four accumulators (lets the compiler vectorize).
+#[inline]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for c in 0..chunks {
+        for l in 0..4 {
+            acc[l] += a[4 * c + l] * b[4 * c + l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for i in 4 * chunks..n {
+        s += a[i] * b[i];
+    }
+    s
+}

@@ -1,0 +1,170 @@
+//! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and horizon. The
+//! measured past is simulated: the model runs from rest in the same sea for `history_s` (a spin-up whose
+//! velocities become the memory and whose end state is the state at t0), then forecasts `horizon_s`.
+
+use crate::files;
+use crate::rom::{self, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use crate::waves::WaveComponent;
+use crate::waves::sea::{self, SeaState};
+use num_complex::Complex64;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    system: String,
+    horizon_s: f64,
+    history_s: f64,
+    #[serde(default = "default_dt")]
+    dt_s: f64,
+    #[serde(default)]
+    speed_m_s: f64,
+    radiation: Option<String>,
+    sea: SeaFile,
+}
+
+fn default_dt() -> f64 {
+    0.1
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SeaFile {
+    hs_m: f64,
+    tp_s: f64,
+    #[serde(default = "one")]
+    gamma: f64,
+    heading_deg: f64,
+    spreading_s: Option<f64>,
+    components: usize,
+    #[serde(default = "wmin")]
+    omega_min_rad_s: f64,
+    #[serde(default = "wmax")]
+    omega_max_rad_s: f64,
+    #[serde(default)]
+    seed: u64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn wmin() -> f64 {
+    0.2
+}
+fn wmax() -> f64 {
+    1.6
+}
+
+/// A validated scenario.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    pub system: PathBuf,
+    pub horizon_s: f64,
+    pub history_s: f64,
+    pub opts: RomOptions,
+    pub sea: SeaState,
+}
+
+impl Scenario {
+    pub fn load(path: &Path) -> anyhow::Result<Scenario> {
+        let text = files::read_text(path)?;
+        let raw: ScenarioFile = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e))?;
+        let bad = |k: &str, m: String| anyhow::anyhow!("{}: {k}: {m}", path.display());
+        for (k, v) in [
+            ("horizon_s", raw.horizon_s),
+            ("history_s", raw.history_s),
+            ("dt_s", raw.dt_s),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(k, format!("must be positive, found {v}")));
+            }
+        }
+        let radiation = match raw.radiation.as_deref() {
+            None | Some("state-space") => RadiationMethod::StateSpace,
+            Some("convolution") => RadiationMethod::Convolution,
+            Some(o) => {
+                return Err(bad(
+                    "radiation",
+                    format!("expected \"convolution\" or \"state-space\", found \"{o}\""),
+                ));
+            }
+        };
+        let s = raw.sea;
+        let sea = SeaState {
+            hs_m: s.hs_m,
+            tp_s: s.tp_s,
+            gamma: s.gamma,
+            heading_rad: s.heading_deg.to_radians(),
+            spreading_s: s.spreading_s,
+            components: s.components,
+            omega_min_rad_s: s.omega_min_rad_s,
+            omega_max_rad_s: s.omega_max_rad_s,
+            seed: s.seed,
+        };
+        sea::validate(&sea).map_err(|m| bad("sea", m))?;
+        Ok(Scenario {
+            system: path.parent().unwrap_or(Path::new(".")).join(raw.system),
+            horizon_s: raw.horizon_s,
+            history_s: raw.history_s,
+            opts: RomOptions {
+                dt_s: raw.dt_s,
+                radiation,
+                speed_m_s: raw.speed_m_s,
+                ..RomOptions::default()
+            },
+            sea,
+        })
+    }
+}
+
+/// The inputs of the forecast at t0, prepared by a spin-up from rest over the history.
+pub struct Prepared {
+    pub x0: Vec<f64>,
+    pub v0: Vec<f64>,
+    pub memory: Memory,
+    /// Components referred to t0.
+    pub waves: Vec<WaveComponent>,
+}
+
+/// Runs the spin-up and returns the state, memory and waves at t0.
+pub fn prepare(model: &TimeModel, sea: &SeaState, history_s: f64) -> rom::Result<Prepared> {
+    let waves = sea::realize(sea);
+    let n = model.n();
+    let zeros = vec![0.0; n];
+    let memory = Memory::new(model);
+    let mut fc = Forecaster::new();
+    let spin = fc.forecast(
+        model,
+        &ForecastRequest {
+            x0: &zeros,
+            v0: &zeros,
+            memory: &memory,
+            waves: &waves,
+            horizon_s: history_s,
+            ramp_s: 30.0_f64.min(history_s / 2.0),
+        },
+    )?;
+    let mut memory = Memory::new(model);
+    let nm = spin.n_modes;
+    let act = |k: usize, arr: &[f64]| -> Vec<f64> { model.active.iter().map(|&i| arr[k * nm + i]).collect() };
+    for k in 0..spin.steps {
+        memory.push(model, &act(k, &spin.v))?;
+    }
+    let t0 = spin.steps as f64 * model.opts.dt_s;
+    let x0 = act(spin.steps, &spin.x);
+    let v0 = act(spin.steps, &spin.v);
+    let u = model.opts.speed_m_s;
+    let waves = waves
+        .into_iter()
+        .map(|w| {
+            let k = crate::waves::wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m);
+            let we = crate::waves::encounter_frequency(w.omega_rad_s, k, u, w.heading_rad);
+            WaveComponent {
+                amplitude_m: w.amplitude_m * Complex64::from_polar(1.0, we * t0),
+                ..w
+            }
+        })
+        .collect();
+    Ok(Prepared { x0, v0, memory, waves })
+}
