@@ -56,6 +56,15 @@ fn wmax() -> f64 {
     1.6
 }
 
+/// Errors reading a scenario: the file, or a key and what is wrong with it.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    File(#[from] files::Error),
+    #[error("{file}: {msg}")]
+    Invalid { file: String, msg: String },
+}
+
 /// A validated scenario.
 #[derive(Debug, Clone)]
 pub struct Scenario {
@@ -67,10 +76,17 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    pub fn load(path: &Path) -> anyhow::Result<Scenario> {
+    pub fn load(path: &Path) -> Result<Scenario, Error> {
         let text = files::read_text(path)?;
-        let raw: ScenarioFile = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e))?;
-        let bad = |k: &str, m: String| anyhow::anyhow!("{}: {k}: {m}", path.display());
+        let file = path.display().to_string();
+        let raw: ScenarioFile = toml::from_str(&text).map_err(|e| Error::Invalid {
+            file: file.clone(),
+            msg: e.to_string(),
+        })?;
+        let bad = |k: &str, m: String| Error::Invalid {
+            file: file.clone(),
+            msg: format!("{k}: {m}"),
+        };
         for (k, v) in [
             ("horizon_s", raw.horizon_s),
             ("history_s", raw.history_s),

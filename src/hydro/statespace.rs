@@ -30,6 +30,10 @@ use num_complex::Complex64;
 pub const DICT_RATIO: f64 = 1.08;
 /// Dictionary: damping ratios at every centre (narrow terms follow steep slopes; wide ones fill humps).
 pub const DICT_ZETAS: [f64; 3] = [0.03, 0.1, 0.3];
+/// Projected-gradient iterations of the PSD gain fit: at most this many, stopping when a step changes
+/// the gains by less than FISTA_STEP_TOL of their size.
+pub const FISTA_MAX_ITERATIONS: usize = 3000;
+pub const FISTA_STEP_TOL: f64 = 1e-7;
 /// Terms whose gain is below this fraction of the largest are dropped.
 pub const PRUNE: f64 = 1e-4;
 
@@ -410,7 +414,7 @@ fn psd_gains(
     let mut x: Vec<DMatrix<f64>> = ls.iter().map(project_psd).collect();
     let mut y = x.clone();
     let mut t = 1.0f64;
-    for _ in 0..20_000 {
+    for _ in 0..FISTA_MAX_ITERATIONS {
         let gy = grad(&y);
         let xn: Vec<DMatrix<f64>> = y
             .iter()
@@ -433,7 +437,7 @@ fn psd_gains(
         y = xn.iter().zip(&x).map(|(a, b)| a + (a - b) * ((t - 1.0) / tn)).collect();
         x = xn;
         t = tn;
-        if step < 1e-9 * size {
+        if step < FISTA_STEP_TOL * size {
             break;
         }
     }

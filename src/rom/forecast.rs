@@ -63,9 +63,18 @@ pub struct Forecaster {
     rr: Vec<f64>,
     ri: Vec<f64>,
     xbuf: Vec<Complex64>,
+    kept_we: Vec<f64>,
+    kept_x: Vec<Complex64>,
+    f0: Vec<f64>,
     // FFT of the kernel (convolution with a history), built on first use
     fft: Option<HistoryFft>,
+    // FFT of the kernel for the forecast's own velocities, block by block
+    block: Option<HistoryFft>,
 }
+
+/// Forecast velocities are convolved directly within a block of this many steps and by FFT beyond it
+/// (uniformly partitioned convolution: the direct sum stays short, the kernel is read once per block).
+pub const CONV_BLOCK: usize = 128;
 
 struct HistoryFft {
     len: usize,
@@ -76,6 +85,36 @@ struct HistoryFft {
     u: Vec<Complex64>,
     acc: Vec<Complex64>,
     scratch: Vec<Complex64>,
+}
+
+impl HistoryFft {
+    /// Spectra of the first `keep` taps of the weighted kernel, zero-padded to `len`.
+    fn new(k: &[f64], taps: usize, n: usize, len: usize, keep: usize) -> HistoryFft {
+        let mut planner = FftPlanner::new();
+        let forward = planner.plan_fft_forward(len);
+        let inverse = planner.plan_fft_inverse(len);
+        let mut kernel = vec![Complex64::default(); n * n * len];
+        let mut scratch =
+            vec![Complex64::default(); forward.get_inplace_scratch_len().max(inverse.get_inplace_scratch_len())];
+        for i in 0..n {
+            for j in 0..n {
+                let s = &mut kernel[(i * n + j) * len..(i * n + j + 1) * len];
+                for m in 0..taps.min(keep).min(len) {
+                    s[m] = Complex64::new(k[(i * taps + m) * n + j], 0.0);
+                }
+                forward.process_with_scratch(s, &mut scratch);
+            }
+        }
+        HistoryFft {
+            len,
+            forward,
+            inverse,
+            kernel,
+            u: vec![Complex64::default(); n * len],
+            acc: vec![Complex64::default(); len],
+            scratch,
+        }
+    }
 }
 
 impl Default for Forecaster {
@@ -98,7 +137,11 @@ impl Forecaster {
             rr: vec![],
             ri: vec![],
             xbuf: vec![],
+            kept_we: vec![],
+            kept_x: vec![],
+            f0: vec![],
             fft: None,
+            block: None,
         }
     }
 
@@ -122,8 +165,9 @@ impl Forecaster {
         {
             self.history_part(model, req.v0, req.memory, steps)?;
         }
-        let f0: Vec<f64> = self.force[..n].to_vec();
-        self.stepper.start(model, req.x0, req.v0, req.memory, steps, &f0)?;
+        self.f0.clear();
+        self.f0.extend_from_slice(&self.force[..n]);
+        self.stepper.start(model, req.x0, req.v0, req.memory, steps, &self.f0)?;
         let nm = model.n_modes;
         self.out.dt_s = dt;
         self.out.n_modes = nm;
@@ -136,16 +180,72 @@ impl Forecaster {
             self.out.x[i] = req.x0[r];
             self.out.v[i] = req.v0[r];
         }
+        let blocked = matches!(model.kernel, Kernel::Convolution { .. }) && steps > 2 * CONV_BLOCK;
+        let mut direct_from = 1;
         for k in 1..=steps {
             let f = &self.force[k * n..(k + 1) * n];
             let kn = &self.known[k * n..(k + 1) * n];
-            self.stepper.step(model, f, kn)?;
+            self.stepper.step(model, f, kn, direct_from)?;
             for (r, &i) in model.active.iter().enumerate() {
                 self.out.x[k * nm + i] = self.stepper.x[r];
                 self.out.v[k * nm + i] = self.stepper.v[r];
             }
+            if blocked && k % CONV_BLOCK == 0 && k < steps {
+                self.block_part(model, k + 1 - CONV_BLOCK, steps)?;
+                direct_from = k + 1;
+            }
         }
         Ok(&self.out)
+    }
+
+    /// Adds to `known` the convolution of the forecast velocities j0..j0+B-1 with the kernel, for every
+    /// later output up to `steps`, by FFT.
+    fn block_part(&mut self, model: &TimeModel, j0: usize, steps: usize) -> Result<()> {
+        let Kernel::Convolution { taps, k } = &model.kernel else {
+            return Ok(());
+        };
+        let (taps, n, b) = (*taps, model.n(), CONV_BLOCK);
+        let len = (steps + b).next_power_of_two();
+        if self
+            .block
+            .as_ref()
+            .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
+        {
+            self.block = Some(HistoryFft::new(k, taps, n, len, len - b));
+        }
+        let Some(f) = self.block.as_mut() else { return Ok(()) };
+        let nm = model.n_modes;
+        f.u.iter_mut().for_each(|c| *c = Complex64::default());
+        for p in 0..b {
+            for (j, &mode) in model.active.iter().enumerate() {
+                f.u[j * len + p] = Complex64::new(self.out.v[(j0 + p) * nm + mode], 0.0);
+            }
+        }
+        for j in 0..n {
+            f.forward
+                .process_with_scratch(&mut f.u[j * len..(j + 1) * len], &mut f.scratch);
+        }
+        let scale = 1.0 / len as f64;
+        for i in 0..n {
+            f.acc.iter_mut().for_each(|c| *c = Complex64::default());
+            for j in 0..n {
+                let kh = &f.kernel[(i * n + j) * len..(i * n + j + 1) * len];
+                let uh = &f.u[j * len..(j + 1) * len];
+                for ((a, kk), uu) in f.acc.iter_mut().zip(kh).zip(uh) {
+                    *a += kk * uu;
+                }
+            }
+            f.inverse.process_with_scratch(&mut f.acc, &mut f.scratch);
+            // output index j0 + q for q >= B (after the block)
+            for q in b..len {
+                let out = j0 + q;
+                if out > steps {
+                    break;
+                }
+                self.known[out * n + i] += f.acc[q].re * scale;
+            }
+        }
+        Ok(())
     }
 
     /// The wave force a request implies at t0 + k dt, k = 0..steps (k-major, active DOFs), through the
@@ -173,7 +273,8 @@ impl Forecaster {
         self.rr.clear();
         self.ri.clear();
         self.xbuf.resize(model.n_modes, Complex64::default());
-        let mut kept = vec![];
+        self.kept_we.clear();
+        self.kept_x.clear();
         let (mut total, mut skipped) = (0.0, 0.0);
         self.out.skipped_components = 0;
         for w in waves {
@@ -200,23 +301,20 @@ impl Forecaster {
             }
             let k = wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m);
             let we = encounter_frequency(w.omega_rad_s, k, u, w.heading_rad);
-            kept.push((
-                we,
-                model
-                    .active
-                    .iter()
-                    .map(|&i| self.xbuf[i] * w.amplitude_m)
-                    .collect::<Vec<_>>(),
-            ));
+            self.kept_we.push(we);
+            for &i in &model.active {
+                self.kept_x.push(self.xbuf[i] * w.amplitude_m);
+            }
         }
         self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
-        let nc = kept.len();
+        let nc = self.kept_we.len();
         self.cr.resize(n * nc, 0.0);
         self.ci.resize(n * nc, 0.0);
-        for (c, (we, x)) in kept.iter().enumerate() {
+        for c in 0..nc {
+            let we = self.kept_we[c];
             for i in 0..n {
-                self.cr[i * nc + c] = x[i].re;
-                self.ci[i * nc + c] = x[i].im;
+                self.cr[i * nc + c] = self.kept_x[c * n + i].re;
+                self.ci[i * nc + c] = self.kept_x[c * n + i].im;
             }
             self.zr.push(1.0);
             self.zi.push(0.0);
@@ -287,7 +385,8 @@ impl Forecaster {
         }
         let Some(f) = self.fft.as_mut() else { return Ok(()) };
         // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0
-        let mut tmp = vec![0.0; n];
+        let mut tmp = std::mem::take(&mut self.f0);
+        tmp.resize(n, 0.0);
         f.u.iter_mut().for_each(|c| *c = Complex64::default());
         for m in 0..taps {
             if m == 0 {
@@ -299,6 +398,7 @@ impl Forecaster {
                 f.u[j * len + taps - 1 - m] = Complex64::new(tmp[j], 0.0);
             }
         }
+        self.f0 = tmp;
         for j in 0..n {
             f.forward
                 .process_with_scratch(&mut f.u[j * len..(j + 1) * len], &mut f.scratch);

@@ -5,7 +5,7 @@
 //! sample with [`Memory::push`] (the daemon does this as measurements arrive, once per sample) or from a
 //! whole history with [`Memory::from_history`].
 
-use super::model::{Kernel, TimeModel};
+use super::model::{Channel, Kernel, TimeModel};
 use super::{Error, Result};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -34,8 +34,8 @@ impl Memory {
                 head: 0,
                 len: 0,
             },
-            Kernel::StateSpace { discrete, .. } => Memory::StateSpace {
-                states: vec![0.0; n * discrete.iter().map(|d| d.order).sum::<usize>()],
+            Kernel::StateSpace { channels, .. } => Memory::StateSpace {
+                states: vec![0.0; channels.iter().map(|c| c.disc.order).sum::<usize>()],
                 last_v: vec![0.0; n],
                 started: false,
             },
@@ -76,10 +76,10 @@ impl Memory {
                     last_v,
                     started,
                 },
-                Kernel::StateSpace { discrete, .. },
+                Kernel::StateSpace { channels, .. },
             ) => {
                 if *started {
-                    advance_states(discrete, states, last_v, v, n);
+                    advance_states(channels, states, last_v, v);
                 }
                 last_v.copy_from_slice(v);
                 *started = true;
@@ -112,29 +112,24 @@ impl Memory {
     }
 }
 
-/// Exact first-order-hold update of every term's states from velocity `v0` to `v1` over one step.
-pub(crate) fn advance_states(
-    discrete: &[crate::hydro::statespace::DiscreteTerm],
-    states: &mut [f64],
-    v0: &[f64],
-    v1: &[f64],
-    n: usize,
-) {
+/// Exact first-order-hold update of every channel's states from velocity `v0` to `v1` over one step.
+pub(crate) fn advance_states(channels: &[Channel], states: &mut [f64], v0: &[f64], v1: &[f64]) {
     let mut off = 0;
     let mut tmp = [0.0f64; 8];
-    for d in discrete {
+    for ch in channels {
+        let d = &ch.disc;
         let m = d.order;
-        for j in 0..n {
-            let x = &mut states[off..off + m];
-            for r in 0..m {
-                let mut acc = d.gamma0[r] * v0[j] + d.gamma1[r] * v1[j];
-                for c in 0..m {
-                    acc += d.phi[r * m + c] * x[c];
-                }
-                tmp[r] = acc;
+        let w0: f64 = ch.u.iter().zip(v0).map(|(a, b)| a * b).sum();
+        let w1: f64 = ch.u.iter().zip(v1).map(|(a, b)| a * b).sum();
+        let x = &mut states[off..off + m];
+        for r in 0..m {
+            let mut acc = d.gamma0[r] * w0 + d.gamma1[r] * w1;
+            for c in 0..m {
+                acc += d.phi[r * m + c] * x[c];
             }
-            x.copy_from_slice(&tmp[..m]);
-            off += m;
+            tmp[r] = acc;
         }
+        x.copy_from_slice(&tmp[..m]);
+        off += m;
     }
 }

@@ -53,15 +53,26 @@ impl Default for RomOptions {
 pub enum Kernel {
     /// `k[(i * taps + m) * n + j] = dt w_m K_m(i, j)`, trapezoid weights w_0 = w_last = 1/2.
     Convolution { taps: usize, k: Vec<f64> },
-    /// Terms with their discretization, gains (n x n) and the output rows c.Phi, c.gamma0, c.gamma1.
-    StateSpace {
-        model: SsModel,
-        discrete: Vec<DiscreteTerm>,
-        c_phi: Vec<Vec<f64>>,
-        c_g0: Vec<f64>,
-        c_g1: Vec<f64>,
-    },
+    /// The fitted model realized as rank-one channels (see [`Channel`]).
+    StateSpace { model: SsModel, channels: Vec<Channel> },
 }
+
+/// One rank-one piece of a state-space term: G_k = sum of lambda u u^T over its eigenvectors, so the
+/// term's force is sum over channels of u y, y = H_k(s) (u . v) with u scaled by sqrt(lambda). A channel
+/// has one scalar input and `order` states; eigenvalues below [`CHANNEL_CUTOFF`] of the largest are
+/// dropped (what is kept is still PSD: passivity holds).
+#[derive(Debug, Clone)]
+pub struct Channel {
+    pub disc: DiscreteTerm,
+    pub u: Vec<f64>,
+    /// c . Phi (row), c . gamma0, c . gamma1.
+    pub c_phi: Vec<f64>,
+    pub c_g0: f64,
+    pub c_g1: f64,
+}
+
+/// Eigenvalues of a term's gain below this fraction of the model's largest (scaled) are dropped.
+pub const CHANNEL_CUTOFF: f64 = 1e-4;
 
 /// Time-domain model over the active DOFs. Matrices are n x n with n = number of active DOFs, in the
 /// order of `active` (global 0-based mode indices).
@@ -74,6 +85,8 @@ pub struct TimeModel {
     pub opts: RomOptions,
     /// M + A_inf.
     pub mass: DMatrix<f64>,
+    /// (M + A_inf)^-1.
+    pub mass_inv: DMatrix<f64>,
     /// B_lin + B_U U.
     pub damping: DMatrix<f64>,
     /// C + C_UQ U^2 (with system-level entries).
@@ -156,36 +169,55 @@ impl TimeModel {
                         ..SsFitOptions::default()
                     },
                 );
-                let discrete: Vec<DiscreteTerm> = model
+                // rank-one channels, in coordinates scaled by sqrt(max_w B_ii) so units do not matter
+                let scale: Vec<f64> = (0..n)
+                    .map(|i| {
+                        b.iter()
+                            .map(|m| m[(i, i)].abs())
+                            .fold(0.0, f64::max)
+                            .sqrt()
+                            .max(f64::MIN_POSITIVE)
+                    })
+                    .collect();
+                let eigs: Vec<_> = model
                     .terms
                     .iter()
-                    .map(|t| statespace::discretize(&t.shape, dt))
+                    .map(|t| DMatrix::from_fn(n, n, |i, j| t.gain[(i, j)] / (scale[i] * scale[j])).symmetric_eigen())
                     .collect();
-                let mut c_phi = vec![];
-                let (mut c_g0, mut c_g1) = (vec![], vec![]);
+                let top = eigs
+                    .iter()
+                    .flat_map(|e| e.eigenvalues.iter().copied())
+                    .fold(0.0, f64::max);
+                let mut channels = vec![];
                 let mut d = DMatrix::zeros(n, n);
-                for (t, dt_) in model.terms.iter().zip(&discrete) {
-                    let m = dt_.order;
-                    c_phi.push(
-                        (0..m)
-                            .map(|col| (0..m).map(|r| dt_.c[r] * dt_.phi[r * m + col]).sum())
-                            .collect(),
-                    );
-                    c_g0.push(dt_.c.iter().zip(&dt_.gamma0).map(|(a, b)| a * b).sum());
-                    let g1: f64 = dt_.c.iter().zip(&dt_.gamma1).map(|(a, b)| a * b).sum();
-                    c_g1.push(g1);
-                    d += &t.gain * g1;
+                for (t, e) in model.terms.iter().zip(&eigs) {
+                    let disc = statespace::discretize(&t.shape, dt);
+                    let m = disc.order;
+                    let c_phi: Vec<f64> = (0..m)
+                        .map(|col| (0..m).map(|r| disc.c[r] * disc.phi[r * m + col]).sum())
+                        .collect();
+                    let c_g0: f64 = disc.c.iter().zip(&disc.gamma0).map(|(a, b)| a * b).sum();
+                    let c_g1: f64 = disc.c.iter().zip(&disc.gamma1).map(|(a, b)| a * b).sum();
+                    for (l, lam) in e.eigenvalues.iter().enumerate() {
+                        if *lam <= CHANNEL_CUTOFF * top {
+                            continue;
+                        }
+                        let u: Vec<f64> = (0..n).map(|i| e.eigenvectors[(i, l)] * lam.sqrt() * scale[i]).collect();
+                        for i in 0..n {
+                            for j in 0..n {
+                                d[(i, j)] += c_g1 * u[i] * u[j];
+                            }
+                        }
+                        channels.push(Channel {
+                            disc: disc.clone(),
+                            u,
+                            c_phi: c_phi.clone(),
+                            c_g0,
+                            c_g1,
+                        });
+                    }
                 }
-                (
-                    Kernel::StateSpace {
-                        model,
-                        discrete,
-                        c_phi,
-                        c_g0,
-                        c_g1,
-                    },
-                    d,
-                )
+                (Kernel::StateSpace { model, channels }, d)
             }
         };
         let s = &mass + (&damping + &d_inst) * (dt / 2.0) + &stiffness * (opts.beta * dt * dt);
@@ -206,12 +238,17 @@ impl TimeModel {
             }),
             RadiationMethod::StateSpace => None,
         };
+        let mass_inv = mass
+            .clone()
+            .try_inverse()
+            .ok_or_else(|| Error::Input("the mass matrix M + A_inf is singular".into()))?;
         Ok(TimeModel {
             n_modes: sys.n_modes(),
             active,
             labels,
             opts,
             mass,
+            mass_inv,
             damping,
             stiffness,
             quadratic,
@@ -278,7 +315,7 @@ impl TimeModel {
     pub fn memory_size(&self) -> usize {
         match &self.kernel {
             Kernel::Convolution { taps, .. } => *taps,
-            Kernel::StateSpace { model, .. } => model.n_states(),
+            Kernel::StateSpace { channels, .. } => channels.iter().map(|c| c.disc.order).sum(),
         }
     }
 }

@@ -150,7 +150,7 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
     let mut k = 0;
     while k < ramp_steps {
         k += 1;
-        st.step(model, &force[k * n..(k + 1) * n], &zeros)?;
+        st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
     }
     loop {
         if k + wsteps > max_steps {
@@ -162,7 +162,7 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
         let start = k + 1;
         for r in 0..wsteps {
             k += 1;
-            st.step(model, &force[k * n..(k + 1) * n], &zeros)?;
+            st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
             record[r * n..(r + 1) * n].copy_from_slice(&st.x);
         }
         let fit = fit_window(&record, n, &we, start as f64 * dt, dt, wsteps);

@@ -30,7 +30,6 @@ pub struct Stepper {
     rhs: Vec<f64>,
     p: Vec<f64>,
     fnl: Vec<f64>,
-    y: Vec<f64>,
     a_new: Vec<f64>,
     v_new: Vec<f64>,
     v_pred: Vec<f64>,
@@ -68,10 +67,9 @@ impl Stepper {
             }
             self.buf = vec![0.0; if taps > 0 { (steps + taps) * n } else { 0 }];
         }
-        if let Kernel::StateSpace { discrete, .. } = &model.kernel {
+        if let Kernel::StateSpace { channels, .. } = &model.kernel {
             self.states
-                .resize(n * discrete.iter().map(|d| d.order).sum::<usize>(), 0.0);
-            self.y.resize(n * discrete.len(), 0.0);
+                .resize(channels.iter().map(|c| c.disc.order).sum::<usize>(), 0.0);
         }
     }
 
@@ -109,7 +107,8 @@ impl Stepper {
         self.x.copy_from_slice(x0);
         self.v.copy_from_slice(v0);
         // radiation force at t0
-        let mut frad = vec![0.0; n];
+        let mut frad = std::mem::take(&mut self.p);
+        frad.iter_mut().for_each(|f| *f = 0.0);
         match (&model.kernel, memory) {
             (Kernel::Convolution { taps, k }, Memory::Convolution { .. }) => {
                 let p0 = self.pos(0);
@@ -124,9 +123,7 @@ impl Stepper {
                 }
             }
             (
-                Kernel::StateSpace {
-                    model: ss, discrete, ..
-                },
+                Kernel::StateSpace { channels, .. },
                 Memory::StateSpace {
                     states,
                     last_v,
@@ -135,21 +132,22 @@ impl Stepper {
             ) => {
                 self.states.copy_from_slice(states);
                 if *started {
-                    advance_states(discrete, &mut self.states, last_v, v0, n);
+                    advance_states(channels, &mut self.states, last_v, v0);
                 }
                 let mut off = 0;
-                for (t, d) in ss.terms.iter().zip(discrete) {
-                    for j in 0..n {
-                        let yj: f64 =
-                            d.c.iter()
-                                .zip(&self.states[off..off + d.order])
-                                .map(|(c, x)| c * x)
-                                .sum();
-                        for (i, f) in frad.iter_mut().enumerate() {
-                            *f += t.gain[(i, j)] * yj;
-                        }
-                        off += d.order;
+                for ch in channels {
+                    let m = ch.disc.order;
+                    let y: f64 = ch
+                        .disc
+                        .c
+                        .iter()
+                        .zip(&self.states[off..off + m])
+                        .map(|(c, x)| c * x)
+                        .sum();
+                    for (f, u) in frad.iter_mut().zip(&ch.u) {
+                        *f += u * y;
                     }
+                    off += m;
                 }
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
@@ -163,14 +161,10 @@ impl Stepper {
             }
             self.rhs[i] = r;
         }
-        let m_inv = model
-            .mass
-            .clone()
-            .try_inverse()
-            .ok_or_else(|| Error::Input("singular mass matrix".into()))?;
         for i in 0..n {
-            self.a[i] = (0..n).map(|j| m_inv[(i, j)] * self.rhs[j]).sum();
+            self.a[i] = (0..n).map(|j| model.mass_inv[(i, j)] * self.rhs[j]).sum();
         }
+        self.p = frad;
         Ok(())
     }
 
@@ -186,9 +180,11 @@ impl Stepper {
         }
     }
 
-    /// Advances one step with the wave force `f1` at the new time and the known radiation part `known`
-    /// (history before t0; zero when there is none).
-    pub fn step(&mut self, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
+    /// Advances one step with the wave force `f1` at the new time and the known radiation part `known`:
+    /// the convolution over the history before t0 and over the forecast's own velocities with index
+    /// below `direct_from` (the caller's block FFTs); the velocities from `direct_from` on are convolved
+    /// here directly. `direct_from = 1` convolves all forecast velocities here.
+    pub fn step(&mut self, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
         let n = self.n;
         let dt = model.opts.dt_s;
         let beta = model.opts.beta;
@@ -199,40 +195,30 @@ impl Stepper {
         // radiation: known part P
         match &model.kernel {
             Kernel::Convolution { taps, k } => {
-                let mcount = (k1 - 1).min(taps - 1);
+                let mcount = k1.saturating_sub(direct_from.max(1)).min(taps - 1);
                 let start = self.pos(k1 as isize - 1);
                 for i in 0..n {
                     let row = &k[(i * taps + 1) * n..(i * taps + 1 + mcount) * n];
                     self.p[i] = known[i] + dot(row, &self.buf[start..start + mcount * n]);
                 }
             }
-            Kernel::StateSpace {
-                model: ss,
-                discrete,
-                c_phi,
-                c_g0,
-                ..
-            } => {
-                let mut off = 0;
-                for (kt, d) in discrete.iter().enumerate() {
-                    for j in 0..n {
-                        let x = &self.states[off..off + d.order];
-                        self.y[kt * n + j] =
-                            c_phi[kt].iter().zip(x).map(|(c, s)| c * s).sum::<f64>() + c_g0[kt] * self.v[j];
-                        off += d.order;
-                    }
-                }
+            Kernel::StateSpace { channels, .. } => {
                 self.p.iter_mut().for_each(|p| *p = 0.0);
-                for (kt, t) in ss.terms.iter().enumerate() {
-                    let y = &self.y[kt * n..(kt + 1) * n];
-                    for j in 0..n {
-                        let yj = y[j];
-                        if yj != 0.0 {
-                            for i in 0..n {
-                                self.p[i] += t.gain[(i, j)] * yj;
-                            }
-                        }
+                let mut off = 0;
+                for ch in channels {
+                    let m = ch.disc.order;
+                    let w: f64 = ch.u.iter().zip(&self.v).map(|(a, b)| a * b).sum();
+                    let y: f64 = ch
+                        .c_phi
+                        .iter()
+                        .zip(&self.states[off..off + m])
+                        .map(|(c, x)| c * x)
+                        .sum::<f64>()
+                        + ch.c_g0 * w;
+                    for (p, u) in self.p.iter_mut().zip(&ch.u) {
+                        *p += u * y;
                     }
+                    off += m;
                 }
             }
         }
@@ -276,7 +262,7 @@ impl Stepper {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
             }
-            Kernel::StateSpace { discrete, .. } => advance_states(discrete, &mut self.states, &self.v, &self.v_new, n),
+            Kernel::StateSpace { channels, .. } => advance_states(channels, &mut self.states, &self.v, &self.v_new),
         }
         std::mem::swap(&mut self.v, &mut self.v_new);
         self.k = k1;
@@ -301,21 +287,23 @@ impl Stepper {
     }
 }
 
-/// Dot product with four accumulators (lets the compiler vectorize).
+/// Dot product with eight independent accumulators over exact chunks (no bounds checks, no dependency
+/// chain): the compiler turns it into packed multiply-adds.
 #[inline]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let chunks = n / 4;
-    for c in 0..chunks {
-        for l in 0..4 {
-            acc[l] += a[4 * c + l] * b[4 * c + l];
+    let mut acc = [0.0f64; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for l in 0..8 {
+            acc[l] += x[l] * y[l];
         }
     }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for i in 4 * chunks..n {
-        s += a[i] * b[i];
+    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
     }
     s
 }

@@ -1,0 +1,84 @@
+//! One 300 s forecast of the one-ship demo (6 DOF) and the two-ship demo (12 DOF, full 12x12 coupling,
+//! every DOF active), both radiation methods, 240 wave components in a short-crested JONSWAP sea
+//! (config/scenarios/two-ship.toml's sea), after a 600 s simulated history; and one integrator step.
+//! Setup (loading, fitting, the spin-up) is outside the timing.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use shipcast::files::load_system;
+use shipcast::rom::stepper::Stepper;
+use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::scenario::{Scenario, prepare};
+use std::hint::black_box;
+use std::path::Path;
+
+fn benches(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sc = Scenario::load(&root.join("config/scenarios/two-ship.toml")).expect("scenario");
+    let mut g = c.benchmark_group("forecast_300s_240_components");
+    g.sample_size(20);
+    for (name, system) in [
+        ("one_ship_6dof", "config/vessels/ship/system.toml"),
+        ("two_ship_12dof", "config/vessels/pair/system.toml"),
+    ] {
+        let sys = load_system(&root.join(system)).expect("demo database").system;
+        for (mname, method) in [
+            ("convolution", RadiationMethod::Convolution),
+            ("state_space", RadiationMethod::StateSpace),
+        ] {
+            let model = TimeModel::new(
+                &sys,
+                RomOptions {
+                    radiation: method,
+                    ..sc.opts
+                },
+            )
+            .expect("model");
+            let prep = prepare(&model, &sc.sea, sc.history_s).expect("spin-up");
+            let mut fc = Forecaster::new();
+            let req = ForecastRequest {
+                x0: &prep.x0,
+                v0: &prep.v0,
+                memory: &prep.memory,
+                waves: &prep.waves,
+                horizon_s: 300.0,
+                ramp_s: 0.0,
+            };
+            g.bench_function(format!("{name}_{mname}"), |b| {
+                b.iter(|| fc.forecast(&model, black_box(&req)).map(|f| f.steps).unwrap())
+            });
+            if name == "two_ship_12dof" {
+                // one step of the integrator (state space), from the prepared state
+                let mut st = Stepper::new();
+                let n = model.n();
+                let zeros = vec![0.0; n];
+                let f = vec![0.0; n];
+                st.start(&model, &prep.x0, &prep.v0, &prep.memory, 1_000_000, &zeros)
+                    .unwrap();
+                if method == RadiationMethod::StateSpace {
+                    c_step(&mut g, &model, &mut st, &f, &zeros);
+                }
+            }
+        }
+    }
+    g.finish();
+}
+
+fn c_step(
+    g: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    model: &TimeModel,
+    st: &mut Stepper,
+    f: &[f64],
+    zeros: &[f64],
+) {
+    g.bench_function("two_ship_12dof_one_step_state_space", |b| {
+        b.iter(|| {
+            if st.k + 1 >= 1_000_000 {
+                st.k = 0;
+            }
+            st.step(model, black_box(f), zeros, 1).unwrap()
+        })
+    });
+}
+
+criterion_group!(forecast, benches);
+criterion_main!(forecast);
