@@ -115,9 +115,19 @@ fn one_ship_time_domain_matches_its_floor_convolution() {
 }
 
 #[test]
+fn one_ship_time_domain_matches_frequency_domain_state_space() {
+    let (e, at) = td_against(
+        "config/vessels/ship/system.toml",
+        "state-space",
+        "frequency",
+        "0.05",
+        None,
+    );
+    assert!(e <= TD_FD_TOL, "{e} at {at}");
+}
+
+#[test]
 fn one_ship_time_domain_matches_its_floor_state_space() {
-    // the state-space model's own floor; against the database it is 1.1-1.3 % off (the fit), see the
-    // closing note of the time-domain issue
     let (e, at) = td_against(
         "config/vessels/ship/system.toml",
         "state-space",

@@ -141,6 +141,18 @@ fn band_pass_re(w0: f64, zeta: f64, w: f64) -> f64 {
 
 /// Fits the model to damping samples `damping[k]` at ascending `omegas[k]` (n x n each, passive).
 pub fn fit(omegas: &[f64], damping: &[DMatrix<f64>], opts: SsFitOptions) -> SsModel {
+    fit_with_added_mass(omegas, damping, None, opts)
+}
+
+/// As [`fit`], and when `added` = (A(w) per frequency, A_inf) is given, the gains also fit
+/// Im K(iw) = w (A(w) - A_inf) (scaled by the damping scale), so that the model's added mass follows
+/// the data locally and not only through its damping's Hilbert transform.
+pub fn fit_with_added_mass(
+    omegas: &[f64],
+    damping: &[DMatrix<f64>],
+    added: Option<(&[DMatrix<f64>], &DMatrix<f64>)>,
+    opts: SsFitOptions,
+) -> SsModel {
     let nw = omegas.len();
     let n = damping.first().map(|b| b.nrows()).unwrap_or(0);
     if nw < 2 || n == 0 {
@@ -248,7 +260,7 @@ pub fn fit(omegas: &[f64], damping: &[DMatrix<f64>], opts: SsFitOptions) -> SsMo
     });
     chosen.dedup();
     let mut terms = chosen;
-    let mut scaled = psd_gains(omegas, &wts, damping, &terms, &sc);
+    let mut scaled = psd_gains(omegas, &wts, damping, added, &terms, &sc);
     // drop negligible terms and refit
     let gmax = scaled.iter().map(|g| g.amax()).fold(0.0, f64::max);
     if scaled.iter().any(|g| g.amax() <= PRUNE * gmax) {
@@ -258,7 +270,7 @@ pub fn fit(omegas: &[f64], damping: &[DMatrix<f64>], opts: SsFitOptions) -> SsMo
             .filter(|(_, g)| g.amax() > PRUNE * gmax)
             .map(|(t, _)| t)
             .collect();
-        scaled = psd_gains(omegas, &wts, damping, &terms, &sc);
+        scaled = psd_gains(omegas, &wts, damping, added, &terms, &sc);
     }
     let out: Vec<SsTerm> = terms
         .iter()
@@ -370,24 +382,41 @@ fn psd_gains(
     omegas: &[f64],
     wts: &[f64],
     damping: &[DMatrix<f64>],
+    added: Option<(&[DMatrix<f64>], &DMatrix<f64>)>,
     terms: &[Shape],
     sc: &dyn Fn(usize, usize) -> f64,
 ) -> Vec<DMatrix<f64>> {
     let (nw, nt) = (omegas.len(), terms.len());
     let n = damping[0].nrows();
     let h = DMatrix::from_fn(nw, nt, |i, k| terms[k].re(omegas[i]));
+    let hi = DMatrix::from_fn(
+        nw,
+        nt,
+        |i, k| if added.is_some() { terms[k].h(omegas[i]).im } else { 0.0 },
+    );
     let normal = DMatrix::from_fn(nt, nt, |k, l| {
-        (0..nw).map(|i| wts[i] * h[(i, k)] * h[(i, l)]).sum::<f64>()
+        (0..nw)
+            .map(|i| wts[i] * (h[(i, k)] * h[(i, l)] + hi[(i, k)] * hi[(i, l)]))
+            .sum::<f64>()
     });
     let scaled: Vec<DMatrix<f64>> = damping
         .iter()
         .map(|b| DMatrix::from_fn(n, n, |i, j| b[(i, j)] / sc(i, j)))
         .collect();
+    // Im K = w (A - A_inf), in the same scaled units
+    let scaled_im: Vec<DMatrix<f64>> = match added {
+        Some((a, a_inf)) => a
+            .iter()
+            .zip(omegas)
+            .map(|(a, w)| DMatrix::from_fn(n, n, |i, j| w * (a[(i, j)] - a_inf[(i, j)]) / sc(i, j)))
+            .collect(),
+        None => vec![DMatrix::zeros(n, n); nw],
+    };
     let r: Vec<DMatrix<f64>> = (0..nt)
         .map(|k| {
             let mut m = DMatrix::zeros(n, n);
             for i in 0..nw {
-                m += &scaled[i] * (wts[i] * h[(i, k)]);
+                m += &scaled[i] * (wts[i] * h[(i, k)]) + &scaled_im[i] * (wts[i] * hi[(i, k)]);
             }
             m
         })

@@ -139,7 +139,7 @@ impl TimeModel {
             (Some(AInfSource::Database), Some(a)) => a.clone(),
             _ => radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, &irf_all)),
         };
-        let mass = sub(&(sys.mass_matrix() + &a_inf_all));
+        let mut mass = sub(&(sys.mass_matrix() + &a_inf_all));
         let damping = sub(&(sys.linear_damping() + sys.body_matrix(|b| &b.speed_damping) * u));
         let stiffness = sub(&(sys.stiffness() + sys.body_matrix(|b| &b.speed_restoring) * (u * u)));
         let q = sub(&sys.body_matrix(|b| &b.quadratic_damping));
@@ -160,10 +160,11 @@ impl TimeModel {
                 (Kernel::Convolution { taps, k }, d)
             }
             RadiationMethod::StateSpace => {
-                let (b, _, _) = active_radiation(sys, &a_inf_all);
-                let model = statespace::fit(
+                let (b, a_act, a_inf_act) = active_radiation(sys, &a_inf_all);
+                let model = statespace::fit_with_added_mass(
                     &sys.db.omega_rad_s,
                     &b,
+                    Some((&a_act, &a_inf_act)),
                     SsFitOptions {
                         tolerance: opts.ss_tolerance,
                         ..SsFitOptions::default()
@@ -217,6 +218,17 @@ impl TimeModel {
                         });
                     }
                 }
+                // A_inf consistent with this model's own kernel (Ogilvie with K_ss): its added mass then
+                // follows the database's, whatever tail the fit gives B beyond the data
+                let estimates: Vec<DMatrix<f64>> = sys
+                    .db
+                    .omega_rad_s
+                    .iter()
+                    .zip(&a_act)
+                    .map(|(w, a)| a - model.kernel(*w).map(|c| c.im / w))
+                    .collect();
+                let a_inf_ss = radiation::ogilvie_a_inf(&estimates);
+                mass = sub(&sys.mass_matrix()) + a_inf_ss;
                 (Kernel::StateSpace { model, channels }, d)
             }
         };
