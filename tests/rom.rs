@@ -7,7 +7,7 @@ use num_complex::Complex64;
 use proptest::prelude::*;
 use shipcast::files::load_system;
 use shipcast::hydro::VesselSystem;
-use shipcast::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use shipcast::rom::{Forecast, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
 use shipcast::waves::WaveComponent;
 use std::collections::HashMap;
 
@@ -138,6 +138,31 @@ fn one_ship_time_domain_matches_its_floor_state_space() {
     assert!(e <= TD_FLOOR_TOL, "{e} at {at}");
 }
 
+/// A run of the forecaster from (x0, v0) with no past motion.
+fn run_from_rest_history(
+    model: &TimeModel,
+    x0: &[f64],
+    v0: &[f64],
+    waves: &[WaveComponent],
+    horizon_s: f64,
+    ramp_s: f64,
+) -> shipcast::rom::Result<Forecast> {
+    let mem = Memory::new(model);
+    let mut fc = Forecaster::new();
+    fc.forecast(
+        model,
+        &ForecastRequest {
+            x0,
+            v0,
+            memory: &mem,
+            waves,
+            horizon_s,
+            ramp_s,
+        },
+    )
+    .cloned()
+}
+
 // ---- WEC-Sim RM3 regularCIC ----
 
 /// The bars.
@@ -162,22 +187,7 @@ fn wecsim_rm3_regular_cic_run() {
         amplitude_m: Complex64::new(1.25, 0.0),
     }];
     let zeros = vec![0.0; model.n()];
-    let mem = Memory::new(&model);
-    let mut fc = Forecaster::new();
-    let f = fc
-        .forecast(
-            &model,
-            &ForecastRequest {
-                x0: &zeros,
-                v0: &zeros,
-                memory: &mem,
-                waves: &waves,
-                horizon_s: 200.0,
-                ramp_s: 100.0,
-            },
-        )
-        .unwrap()
-        .clone();
+    let f = run_from_rest_history(&model, &zeros, &zeros, &waves, 200.0, 100.0).unwrap();
     // steady state over the last 6 periods (152..200 s): least squares on cos, sin, 1
     for (mode, amp_ref, ph_ref) in [(2usize, 0.98395, -24.83f64), (8, 0.12408, -43.31)] {
         let ks: Vec<usize> = (1520..=2000).collect();
@@ -270,21 +280,7 @@ fn free_decay_never_gains_energy(method: RadiationMethod, heave_m: f64, roll_rad
     x0[3] = roll_rad;
     x0[4] = pitch_rad;
     let v0 = vec![0.0; model.n()];
-    let mem = Memory::new(&model);
-    let mut fc = Forecaster::new();
-    let f = fc
-        .forecast(
-            &model,
-            &ForecastRequest {
-                x0: &x0,
-                v0: &v0,
-                memory: &mem,
-                waves: &[],
-                horizon_s: 200.0,
-                ramp_s: 0.0,
-            },
-        )
-        .unwrap();
+    let f = run_from_rest_history(&model, &x0, &v0, &[], 200.0, 0.0).unwrap();
     let e0 = energy(&model, &x0, &v0);
     let act = |k: usize, a: &[f64]| -> Vec<f64> { model.active.iter().map(|&i| a[k * f.n_modes + i]).collect() };
     let mut max = 0.0f64;
@@ -334,21 +330,7 @@ fn halving_dt_shrinks_the_error_at_second_order() {
             amplitude_m: Complex64::new(1.0, 0.0),
         }];
         let zeros = vec![0.0; model.n()];
-        let mem = Memory::new(&model);
-        let mut fc = Forecaster::new();
-        let f = fc
-            .forecast(
-                &model,
-                &ForecastRequest {
-                    x0: &zeros,
-                    v0: &zeros,
-                    memory: &mem,
-                    waves: &waves,
-                    horizon_s: 160.0,
-                    ramp_s: 40.0,
-                },
-            )
-            .unwrap();
+        let f = run_from_rest_history(&model, &zeros, &zeros, &waves, 160.0, 40.0).unwrap();
         f.at(f.steps, 2)
     };
     let reference = run(0.0125);
@@ -367,20 +349,7 @@ fn a_diverging_state_is_reported_with_its_dof_and_time() {
     let mut x0 = vec![0.0; model.n()];
     x0[2] = 0.01;
     let v0 = vec![0.0; model.n()];
-    let mem = Memory::new(&model);
-    let mut fc = Forecaster::new();
-    let err = fc
-        .forecast(
-            &model,
-            &ForecastRequest {
-                x0: &x0,
-                v0: &v0,
-                memory: &mem,
-                waves: &[],
-                horizon_s: 300.0,
-                ramp_s: 0.0,
-            },
-        )
+    let err = run_from_rest_history(&model, &x0, &v0, &[], 300.0, 0.0)
         .unwrap_err()
         .to_string();
     assert!(

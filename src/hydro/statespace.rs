@@ -213,17 +213,7 @@ pub fn fit_with_added_mass(
                 .copied()
                 .enumerate()
                 .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
-            let gmax = g.iter().copied().fold(0.0, f64::max);
-            if rmax <= 0.5 * opts.tolerance {
-                chosen.extend(
-                    terms
-                        .iter()
-                        .zip(&g)
-                        .filter(|(_, gk)| **gk > PRUNE * gmax)
-                        .map(|(t, _)| *t),
-                );
-                break;
-            }
+            // a narrow term at the largest residual, as wide as the residual's peak at half maximum
             let mut l = imax;
             while l > 0 && resid[l] > 0.5 * rmax {
                 l -= 1;
@@ -233,13 +223,13 @@ pub fn fit_with_added_mass(
                 r += 1;
             }
             let width = (omegas[r] - omegas[l]).max(omegas[(imax + 1).min(nw - 1)] - omegas[imax.saturating_sub(1)]);
-            let zeta = (0.5 * width / omegas[imax]).clamp(0.002, 0.5);
             let new = Shape {
                 omega_rad_s: omegas[imax],
-                zeta,
+                zeta: (0.5 * width / omegas[imax]).clamp(0.002, 0.5),
                 fourth: false,
             };
-            if terms.contains(&new) || terms.len() >= dict.len() + opts.max_terms {
+            if rmax <= 0.5 * opts.tolerance || terms.contains(&new) || terms.len() >= dict.len() + opts.max_terms {
+                let gmax = g.iter().copied().fold(0.0, f64::max);
                 chosen.extend(
                     terms
                         .iter()

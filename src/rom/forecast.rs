@@ -88,6 +88,29 @@ struct HistoryFft {
 }
 
 impl HistoryFft {
+    /// Forward FFT of every input sequence in `u`.
+    fn transform_inputs(&mut self, n: usize) {
+        let len = self.len;
+        for j in 0..n {
+            self.forward
+                .process_with_scratch(&mut self.u[j * len..(j + 1) * len], &mut self.scratch);
+        }
+    }
+
+    /// `acc` = len x (the linear convolution of the inputs with row i of the kernel), by the spectra.
+    fn output(&mut self, i: usize, n: usize) {
+        let len = self.len;
+        self.acc.iter_mut().for_each(|c| *c = Complex64::default());
+        for j in 0..n {
+            let kh = &self.kernel[(i * n + j) * len..(i * n + j + 1) * len];
+            let uh = &self.u[j * len..(j + 1) * len];
+            for ((a, kk), uu) in self.acc.iter_mut().zip(kh).zip(uh) {
+                *a += kk * uu;
+            }
+        }
+        self.inverse.process_with_scratch(&mut self.acc, &mut self.scratch);
+    }
+
     /// Spectra of the first `keep` taps of the weighted kernel, zero-padded to `len`.
     fn new(k: &[f64], taps: usize, n: usize, len: usize, keep: usize) -> HistoryFft {
         let mut planner = FftPlanner::new();
@@ -221,21 +244,10 @@ impl Forecaster {
                 f.u[j * len + p] = Complex64::new(self.out.v[(j0 + p) * nm + mode], 0.0);
             }
         }
-        for j in 0..n {
-            f.forward
-                .process_with_scratch(&mut f.u[j * len..(j + 1) * len], &mut f.scratch);
-        }
+        f.transform_inputs(n);
         let scale = 1.0 / len as f64;
         for i in 0..n {
-            f.acc.iter_mut().for_each(|c| *c = Complex64::default());
-            for j in 0..n {
-                let kh = &f.kernel[(i * n + j) * len..(i * n + j + 1) * len];
-                let uh = &f.u[j * len..(j + 1) * len];
-                for ((a, kk), uu) in f.acc.iter_mut().zip(kh).zip(uh) {
-                    *a += kk * uu;
-                }
-            }
-            f.inverse.process_with_scratch(&mut f.acc, &mut f.scratch);
+            f.output(i, n);
             // output index j0 + q for q >= B (after the block)
             for q in b..len {
                 let out = j0 + q;
@@ -399,21 +411,10 @@ impl Forecaster {
             }
         }
         self.f0 = tmp;
-        for j in 0..n {
-            f.forward
-                .process_with_scratch(&mut f.u[j * len..(j + 1) * len], &mut f.scratch);
-        }
+        f.transform_inputs(n);
         let scale = 1.0 / len as f64;
         for i in 0..n {
-            f.acc.iter_mut().for_each(|c| *c = Complex64::default());
-            for j in 0..n {
-                let kh = &f.kernel[(i * n + j) * len..(i * n + j + 1) * len];
-                let uh = &f.u[j * len..(j + 1) * len];
-                for ((a, kk), uu) in f.acc.iter_mut().zip(kh).zip(uh) {
-                    *a += kk * uu;
-                }
-            }
-            f.inverse.process_with_scratch(&mut f.acc, &mut f.scratch);
+            f.output(i, n);
             for kk in 1..=steps.min(taps - 1) {
                 self.known[kk * n + i] = f.acc[kk + taps - 1].re * scale;
             }
