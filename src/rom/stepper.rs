@@ -31,6 +31,8 @@ pub struct Stepper {
     p: Vec<f64>,
     fnl: Vec<f64>,
     a_new: Vec<f64>,
+    /// State space: each channel's input u . v at the current step.
+    w: Vec<f64>,
     v_new: Vec<f64>,
     v_pred: Vec<f64>,
 }
@@ -70,6 +72,7 @@ impl Stepper {
         if let Kernel::StateSpace { channels, .. } = &model.kernel {
             self.states
                 .resize(channels.iter().map(|c| c.disc.order).sum::<usize>(), 0.0);
+            self.w.resize(channels.len(), 0.0);
         }
     }
 
@@ -149,6 +152,9 @@ impl Stepper {
                     }
                     off += m;
                 }
+                for (w, ch) in self.w.iter_mut().zip(channels) {
+                    *w = ch.u.iter().zip(v0).map(|(a, b)| a * b).sum();
+                }
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
         }
@@ -205,9 +211,8 @@ impl Stepper {
             Kernel::StateSpace { channels, .. } => {
                 self.p.iter_mut().for_each(|p| *p = 0.0);
                 let mut off = 0;
-                for ch in channels {
+                for (ch, &w) in channels.iter().zip(&self.w) {
                     let m = ch.disc.order;
-                    let w: f64 = ch.u.iter().zip(&self.v).map(|(a, b)| a * b).sum();
                     let y: f64 = ch
                         .c_phi
                         .iter()
@@ -262,7 +267,27 @@ impl Stepper {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
             }
-            Kernel::StateSpace { channels, .. } => advance_states(channels, &mut self.states, &self.v, &self.v_new),
+            Kernel::StateSpace { channels, .. } => {
+                // each channel's input u . v, kept for the next step: one dot product per channel
+                let mut off = 0;
+                let mut tmp = [0.0f64; 8];
+                for (ch, w0) in channels.iter().zip(self.w.iter_mut()) {
+                    let d = &ch.disc;
+                    let m = d.order;
+                    let w1: f64 = ch.u.iter().zip(&self.v_new).map(|(a, b)| a * b).sum();
+                    let x = &mut self.states[off..off + m];
+                    for r in 0..m {
+                        let mut acc = d.gamma0[r] * *w0 + d.gamma1[r] * w1;
+                        for c in 0..m {
+                            acc += d.phi[r * m + c] * x[c];
+                        }
+                        tmp[r] = acc;
+                    }
+                    x.copy_from_slice(&tmp[..m]);
+                    *w0 = w1;
+                    off += m;
+                }
+            }
         }
         std::mem::swap(&mut self.v, &mut self.v_new);
         self.k = k1;
