@@ -111,6 +111,20 @@ fn damping_nodes(omegas: &[f64], damping: &[DMatrix<f64>], n: usize) -> (Vec<f64
     (w, b)
 }
 
+/// max_w |M_ii(w)| for each i: the scale of each DOF in a frequency-dependent matrix (at least the
+/// smallest positive number, so it can divide).
+pub fn diagonal_peaks(ms: &[DMatrix<f64>]) -> Vec<f64> {
+    let n = ms.first().map(|m| m.nrows()).unwrap_or(0);
+    (0..n)
+        .map(|i| {
+            ms.iter()
+                .map(|m| m[(i, i)].abs())
+                .fold(0.0, f64::max)
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect()
+}
+
 /// The database's damping made passive: at each frequency the symmetric part of B(w) is projected onto
 /// the positive semi-definite matrices (negative eigenvalues, from irregular frequencies or numerical
 /// noise, set to zero; eigen-decomposition in coordinates scaled by sqrt(max_w B_ii) so translations and
@@ -121,16 +135,7 @@ pub fn passive_damping(damping: &[DMatrix<f64>]) -> (Vec<DMatrix<f64>>, f64) {
         return (vec![], 0.0);
     };
     let n = first.nrows();
-    let scale: Vec<f64> = (0..n)
-        .map(|i| {
-            damping
-                .iter()
-                .map(|b| b[(i, i)].abs())
-                .fold(0.0, f64::max)
-                .sqrt()
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
+    let scale: Vec<f64> = diagonal_peaks(damping).into_iter().map(f64::sqrt).collect();
     let mut worst = 0.0f64;
     let out = damping
         .iter()

@@ -169,15 +169,7 @@ pub fn fit_with_added_mass(
             (0.5 * (hi - lo)).max(1e-12)
         })
         .collect();
-    let scale: Vec<f64> = (0..n)
-        .map(|i| {
-            damping
-                .iter()
-                .map(|b| b[(i, i)].abs())
-                .fold(0.0, f64::max)
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
+    let scale = super::radiation::diagonal_peaks(damping);
     let sc = |i: usize, j: usize| (scale[i] * scale[j]).sqrt();
     // dictionary
     let mut dict: Vec<Shape> = vec![];

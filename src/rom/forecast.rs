@@ -370,30 +370,7 @@ impl Forecaster {
             .as_ref()
             .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
         {
-            let mut planner = FftPlanner::new();
-            let forward = planner.plan_fft_forward(len);
-            let inverse = planner.plan_fft_inverse(len);
-            let mut kernel = vec![Complex64::default(); n * n * len];
-            let mut scratch =
-                vec![Complex64::default(); forward.get_inplace_scratch_len().max(inverse.get_inplace_scratch_len())];
-            for i in 0..n {
-                for j in 0..n {
-                    let s = &mut kernel[(i * n + j) * len..(i * n + j + 1) * len];
-                    for m in 0..taps {
-                        s[m] = Complex64::new(k[(i * taps + m) * n + j], 0.0);
-                    }
-                    forward.process_with_scratch(s, &mut scratch);
-                }
-            }
-            self.fft = Some(HistoryFft {
-                len,
-                forward,
-                inverse,
-                kernel,
-                u: vec![Complex64::default(); n * len],
-                acc: vec![Complex64::default(); len],
-                scratch,
-            });
+            self.fft = Some(HistoryFft::new(k, taps, n, len, taps));
         }
         let Some(f) = self.fft.as_mut() else { return Ok(()) };
         // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0

@@ -112,24 +112,29 @@ impl Memory {
     }
 }
 
+/// Exact first-order-hold update of one channel's states over a step, input w0 -> w1.
+#[inline]
+pub(crate) fn update_channel(d: &crate::hydro::statespace::DiscreteTerm, x: &mut [f64], w0: f64, w1: f64) {
+    let m = d.order;
+    let mut tmp = [0.0f64; 8];
+    for r in 0..m {
+        let mut acc = d.gamma0[r] * w0 + d.gamma1[r] * w1;
+        for c in 0..m {
+            acc += d.phi[r * m + c] * x[c];
+        }
+        tmp[r] = acc;
+    }
+    x.copy_from_slice(&tmp[..m]);
+}
+
 /// Exact first-order-hold update of every channel's states from velocity `v0` to `v1` over one step.
 pub(crate) fn advance_states(channels: &[Channel], states: &mut [f64], v0: &[f64], v1: &[f64]) {
     let mut off = 0;
-    let mut tmp = [0.0f64; 8];
     for ch in channels {
-        let d = &ch.disc;
-        let m = d.order;
+        let m = ch.disc.order;
         let w0: f64 = ch.u.iter().zip(v0).map(|(a, b)| a * b).sum();
         let w1: f64 = ch.u.iter().zip(v1).map(|(a, b)| a * b).sum();
-        let x = &mut states[off..off + m];
-        for r in 0..m {
-            let mut acc = d.gamma0[r] * w0 + d.gamma1[r] * w1;
-            for c in 0..m {
-                acc += d.phi[r * m + c] * x[c];
-            }
-            tmp[r] = acc;
-        }
-        x.copy_from_slice(&tmp[..m]);
+        update_channel(&ch.disc, &mut states[off..off + m], w0, w1);
         off += m;
     }
 }

@@ -171,15 +171,7 @@ impl TimeModel {
                     },
                 );
                 // rank-one channels, in coordinates scaled by sqrt(max_w B_ii) so units do not matter
-                let scale: Vec<f64> = (0..n)
-                    .map(|i| {
-                        b.iter()
-                            .map(|m| m[(i, i)].abs())
-                            .fold(0.0, f64::max)
-                            .sqrt()
-                            .max(f64::MIN_POSITIVE)
-                    })
-                    .collect();
+                let scale: Vec<f64> = radiation::diagonal_peaks(&b).into_iter().map(f64::sqrt).collect();
                 let eigs: Vec<_> = model
                     .terms
                     .iter()

@@ -2,7 +2,7 @@
 //! radiation force split into a known part and an implicit instantaneous part (see [`super`]).
 //! The stepper owns only reusable workspace; what it reads comes in as arguments.
 
-use super::memory::{Memory, advance_states};
+use super::memory::{Memory, advance_states, update_channel};
 use super::model::{Kernel, TimeModel};
 use super::{Error, Result};
 
@@ -270,20 +270,10 @@ impl Stepper {
             Kernel::StateSpace { channels, .. } => {
                 // each channel's input u . v, kept for the next step: one dot product per channel
                 let mut off = 0;
-                let mut tmp = [0.0f64; 8];
                 for (ch, w0) in channels.iter().zip(self.w.iter_mut()) {
-                    let d = &ch.disc;
-                    let m = d.order;
+                    let m = ch.disc.order;
                     let w1: f64 = ch.u.iter().zip(&self.v_new).map(|(a, b)| a * b).sum();
-                    let x = &mut self.states[off..off + m];
-                    for r in 0..m {
-                        let mut acc = d.gamma0[r] * *w0 + d.gamma1[r] * w1;
-                        for c in 0..m {
-                            acc += d.phi[r * m + c] * x[c];
-                        }
-                        tmp[r] = acc;
-                    }
-                    x.copy_from_slice(&tmp[..m]);
+                    update_channel(&ch.disc, &mut self.states[off..off + m], *w0, w1);
                     *w0 = w1;
                     off += m;
                 }
