@@ -33,7 +33,7 @@ fn benches(c: &mut Criterion) {
                 },
             )
             .expect("model");
-            let prep = prepare(&model, &sc.sea, sc.history_s).expect("spin-up");
+            let prep = prepare(&model, &sc.waves, sc.history_s).expect("spin-up");
             let mut fc = Forecaster::new();
             let req = ForecastRequest {
                 x0: &prep.x0,

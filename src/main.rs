@@ -419,7 +419,7 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
     let t_build = std::time::Instant::now();
     let model = TimeModel::new(sys, sc.opts).with_context(|| sc.system.display().to_string())?;
     let build_s = t_build.elapsed().as_secs_f64();
-    let prep = prepare(&model, &sc.sea, sc.history_s).context("spin-up of the history")?;
+    let prep = prepare(&model, &sc.waves, sc.history_s).context("spin-up of the history")?;
     let mut fc = Forecaster::new();
     let req = ForecastRequest {
         x0: &prep.x0,

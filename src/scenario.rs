@@ -21,7 +21,21 @@ struct ScenarioFile {
     #[serde(default)]
     speed_m_s: f64,
     radiation: Option<String>,
-    sea: SeaFile,
+    sea: Option<SeaFile>,
+    /// Explicit components instead of a sea state: amplitude and phase at the origin at the start of
+    /// the history (t = -history_s).
+    #[serde(default)]
+    component: Vec<ComponentFile>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ComponentFile {
+    omega_rad_s: f64,
+    heading_deg: f64,
+    amplitude_m: f64,
+    #[serde(default)]
+    phase_deg: f64,
 }
 
 fn default_dt() -> f64 {
@@ -65,6 +79,13 @@ pub enum Error {
     Invalid { file: String, msg: String },
 }
 
+/// The waves of a scenario: a sea state to realize, or components as given.
+#[derive(Debug, Clone)]
+pub enum Waves {
+    Sea(SeaState),
+    Components(Vec<WaveComponent>),
+}
+
 /// A validated scenario.
 #[derive(Debug, Clone)]
 pub struct Scenario {
@@ -72,7 +93,7 @@ pub struct Scenario {
     pub horizon_s: f64,
     pub history_s: f64,
     pub opts: RomOptions,
-    pub sea: SeaState,
+    pub waves: Waves,
 }
 
 impl Scenario {
@@ -106,19 +127,52 @@ impl Scenario {
                 ));
             }
         };
-        let s = raw.sea;
-        let sea = SeaState {
-            hs_m: s.hs_m,
-            tp_s: s.tp_s,
-            gamma: s.gamma,
-            heading_rad: s.heading_deg.to_radians(),
-            spreading_s: s.spreading_s,
-            components: s.components,
-            omega_min_rad_s: s.omega_min_rad_s,
-            omega_max_rad_s: s.omega_max_rad_s,
-            seed: s.seed,
+        let waves = match (raw.sea, raw.component.is_empty()) {
+            (Some(s), true) => {
+                let sea = SeaState {
+                    hs_m: s.hs_m,
+                    tp_s: s.tp_s,
+                    gamma: s.gamma,
+                    heading_rad: s.heading_deg.to_radians(),
+                    spreading_s: s.spreading_s,
+                    components: s.components,
+                    omega_min_rad_s: s.omega_min_rad_s,
+                    omega_max_rad_s: s.omega_max_rad_s,
+                    seed: s.seed,
+                };
+                sea::validate(&sea).map_err(|m| bad("sea", m))?;
+                Waves::Sea(sea)
+            }
+            (None, false) => {
+                let mut out = vec![];
+                for (k, c) in raw.component.iter().enumerate() {
+                    let ok = c.omega_rad_s.is_finite()
+                        && c.omega_rad_s > 0.0
+                        && c.heading_deg.is_finite()
+                        && c.amplitude_m.is_finite()
+                        && c.amplitude_m >= 0.0
+                        && c.phase_deg.is_finite();
+                    if !ok {
+                        return Err(bad(
+                            &format!("component[{k}]"),
+                            "needs omega_rad_s > 0, amplitude_m >= 0 and finite heading_deg, phase_deg".into(),
+                        ));
+                    }
+                    out.push(WaveComponent {
+                        omega_rad_s: c.omega_rad_s,
+                        heading_rad: c.heading_deg.to_radians(),
+                        amplitude_m: Complex64::from_polar(c.amplitude_m, c.phase_deg.to_radians()),
+                    });
+                }
+                Waves::Components(out)
+            }
+            _ => {
+                return Err(bad(
+                    "sea",
+                    "give either a [sea] table or [[component]] entries, not both, not neither".into(),
+                ));
+            }
         };
-        sea::validate(&sea).map_err(|m| bad("sea", m))?;
         Ok(Scenario {
             system: path.parent().unwrap_or(Path::new(".")).join(raw.system),
             horizon_s: raw.horizon_s,
@@ -129,7 +183,7 @@ impl Scenario {
                 speed_m_s: raw.speed_m_s,
                 ..RomOptions::default()
             },
-            sea,
+            waves,
         })
     }
 }
@@ -144,8 +198,11 @@ pub struct Prepared {
 }
 
 /// Runs the spin-up and returns the state, memory and waves at t0.
-pub fn prepare(model: &TimeModel, sea: &SeaState, history_s: f64) -> rom::Result<Prepared> {
-    let waves = sea::realize(sea);
+pub fn prepare(model: &TimeModel, waves: &Waves, history_s: f64) -> rom::Result<Prepared> {
+    let waves = match waves {
+        Waves::Sea(sea) => sea::realize(sea),
+        Waves::Components(c) => c.clone(),
+    };
     let n = model.n();
     let zeros = vec![0.0; n];
     let memory = Memory::new(model);

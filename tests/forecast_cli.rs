@@ -1,0 +1,74 @@
+//! `shipcast forecast`: output layout, the timing line, bad scenarios.
+
+use crate::util::{repo, shipcast};
+
+const SCENARIO: &str = "tests/data/scenarios/one-ship-components.toml";
+
+#[test]
+fn csv_forecast_and_timing_line() {
+    let (ok, out, err) = shipcast(&["forecast", SCENARIO, "--repeat", "3"]);
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(
+        lines[0],
+        "t_s,carrier.surge,carrier.sway,carrier.heave,carrier.roll,carrier.pitch,carrier.yaw"
+    );
+    // 60 s at 0.1 s: 601 rows, then the timing line
+    assert_eq!(lines.len(), 1 + 601 + 1, "{}", lines.len());
+    let last = lines[lines.len() - 1];
+    let parts: Vec<&str> = last.split(' ').collect();
+    assert!(
+        parts.len() == 2 && parts[0].starts_with("forecast_ms_median=") && parts[1].starts_with("forecast_ms_p95="),
+        "{last}"
+    );
+    for p in parts {
+        let v: f64 = p.split('=').nth(1).unwrap().parse().unwrap();
+        assert!(v > 0.0 && v.is_finite());
+    }
+    // every value finite, and heave moves
+    let heave: Vec<f64> = lines[1..602]
+        .iter()
+        .map(|l| l.split(',').nth(3).unwrap().parse::<f64>().unwrap())
+        .collect();
+    assert!(heave.iter().all(|h| h.is_finite()));
+    assert!(heave.iter().cloned().fold(0.0, f64::max) > 0.1, "heave barely moves");
+}
+
+#[test]
+fn json_forecast_to_a_file() {
+    let out_path = std::env::temp_dir().join(format!("shipcast-forecast-{}.json", std::process::id()));
+    let (ok, _, err) = shipcast(&[
+        "forecast",
+        SCENARIO,
+        "--format",
+        "json",
+        "--out",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    let _ = std::fs::remove_file(&out_path);
+    assert!(
+        text.starts_with("{\"dt_s\":0.1,\"horizon_s\":60,") && text.contains("\"carrier.heave\":["),
+        "{}",
+        &text[..120.min(text.len())]
+    );
+}
+
+#[test]
+fn a_scenario_with_sea_and_components_is_refused() {
+    let dir = std::env::temp_dir().join(format!("shipcast-scenario-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(repo(SCENARIO)).unwrap().replace(
+        "../../../config/vessels/ship/system.toml",
+        repo("config/vessels/ship/system.toml").to_str().unwrap(),
+    ) + "\n[sea]\nhs_m = 2.0\ntp_s = 8.0\nheading_deg = 180.0\ncomponents = 10\n";
+    let path = dir.join("both.toml");
+    std::fs::write(&path, text).unwrap();
+    let (ok, _, err) = shipcast(&["forecast", path.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        !ok && err.contains("give either a [sea] table or [[component]] entries"),
+        "{err}"
+    );
+}
