@@ -54,10 +54,16 @@ pub fn active_radiation(
     (b, sys.db.added_mass.iter().map(sub).collect(), sub(a_inf))
 }
 
-/// The state-space fit of the active DOFs' radiation and its (damping, added mass) errors.
+/// The state-space fit of the active DOFs' radiation as the time-domain model makes it (damping and
+/// added mass fitted, A_inf given), and its (damping, added mass) errors.
 pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> (statespace::SsModel, f64, f64) {
     let (b, a, ai) = active_radiation(sys, a_inf);
-    let model = statespace::fit(&sys.db.omega_rad_s, &b, statespace::SsFitOptions::default());
+    let model = statespace::fit_with_added_mass(
+        &sys.db.omega_rad_s,
+        &b,
+        Some((&a, &ai)),
+        statespace::SsFitOptions::default(),
+    );
     let (eb, ea) = statespace::fit_errors(&model, &sys.db.omega_rad_s, &b, &a, &ai);
     (model, eb, ea)
 }
