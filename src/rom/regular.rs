@@ -74,7 +74,6 @@ pub fn time_domain_rao(
 }
 
 fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions) -> Result<TimeRao> {
-    let n = model.n();
     let dt = model.opts.dt_s;
     let we: Vec<f64> = omegas
         .iter()
@@ -120,7 +119,40 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
             amplitude_m: Complex64::new(1.0, 0.0),
         })
         .collect();
-    // the wave force for the whole run, from the forecaster's own code path
+    let ramp_steps = (ramp_s / dt).ceil() as usize;
+    // Run for a limited time and double it while the steady state is not reached: the force and the
+    // stepper's memory are sized for what is simulated, not for `max_time_s`. The trajectory up to a
+    // limit is the same whatever the limit, so the result does not depend on the doubling.
+    let mut limit = (ramp_steps + 4 * wsteps).min(max_steps);
+    loop {
+        if let Some(rao) = run_until(model, &waves, &we, ramp_s, ramp_steps, wsteps, limit, opts.tolerance)? {
+            return Ok(rao);
+        }
+        if limit >= max_steps {
+            return Err(Error::Input(format!(
+                "no steady state within {} s (tolerance {})",
+                opts.max_time_s, opts.tolerance
+            )));
+        }
+        limit = (2 * limit).min(max_steps);
+    }
+}
+
+/// One run from rest of at most `limit` steps; None when the steady state is not reached by then.
+#[allow(clippy::too_many_arguments)]
+fn run_until(
+    model: &TimeModel,
+    waves: &[WaveComponent],
+    we: &[f64],
+    ramp_s: f64,
+    ramp_steps: usize,
+    wsteps: usize,
+    limit: usize,
+    tolerance: f64,
+) -> Result<Option<TimeRao>> {
+    let n = model.n();
+    let dt = model.opts.dt_s;
+    // the wave force, from the forecaster's own code path
     let mut fc = Forecaster::new();
     let memory = Memory::new(model);
     let zeros = vec![0.0; n];
@@ -130,8 +162,8 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
             x0: &zeros,
             v0: &zeros,
             memory: &memory,
-            waves: &waves,
-            horizon_s: max_steps as f64 * dt,
+            waves,
+            horizon_s: limit as f64 * dt,
             ramp_s,
         },
     )?;
@@ -139,33 +171,26 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
         return Err(Error::Input(format!(
             "frequency or heading outside the database ({} of {} components)",
             fc.skipped(),
-            omegas.len()
+            waves.len()
         )));
     }
     let mut st = Stepper::new();
-    st.start(model, &zeros, &zeros, &memory, max_steps, &force[..n])?;
-    let ramp_steps = (ramp_s / dt).ceil() as usize;
-    let mut record = vec![0.0; (wsteps) * n];
+    st.start(model, &zeros, &zeros, &memory, limit, &force[..n])?;
+    let mut record = vec![0.0; wsteps * n];
     let mut prev: Option<Vec<Vec<Complex64>>> = None;
     let mut k = 0;
-    while k < ramp_steps {
+    while k < ramp_steps.min(limit) {
         k += 1;
         st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
     }
-    loop {
-        if k + wsteps > max_steps {
-            return Err(Error::Input(format!(
-                "no steady state within {} s (tolerance {})",
-                opts.max_time_s, opts.tolerance
-            )));
-        }
+    while k + wsteps <= limit {
         let start = k + 1;
         for r in 0..wsteps {
             k += 1;
             st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
             record[r * n..(r + 1) * n].copy_from_slice(&st.x);
         }
-        let fit = fit_window(&record, n, &we, start as f64 * dt, dt, wsteps);
+        let fit = fit_window(&record, n, we, start as f64 * dt, dt, wsteps);
         if let Some(p) = &prev {
             let peak = fit.iter().flatten().map(|c| c.norm()).fold(0.0, f64::max);
             let change = fit
@@ -175,7 +200,7 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
                 .map(|(a, b)| (a - b).norm())
                 .fold(0.0, f64::max);
             tracing::debug!(t_s = k as f64 * dt, change, peak, "regular-wave window");
-            if change <= opts.tolerance * peak.max(f64::MIN_POSITIVE) {
+            if change <= tolerance * peak.max(f64::MIN_POSITIVE) {
                 let rao = fit
                     .into_iter()
                     .map(|act| {
@@ -186,14 +211,15 @@ fn run(model: &TimeModel, heading_rad: f64, omegas: &[f64], opts: RegularOptions
                         all
                     })
                     .collect();
-                return Ok(TimeRao {
+                return Ok(Some(TimeRao {
                     rao,
                     settled_s: k as f64 * dt,
-                });
+                }));
             }
         }
         prev = Some(fit);
     }
+    Ok(None)
 }
 
 /// Least-squares fit of x(t) = sum_j Re{X_j exp(i w_j t)} + c0 + c1 t + c2 t^2 over one window; returns X[j][dof].
