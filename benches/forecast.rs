@@ -6,7 +6,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::files::load_system;
 use shipcast::rom::stepper::Stepper;
-use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel};
 use shipcast::scenario::{Scenario, prepare};
 use std::hint::black_box;
 use std::path::Path;
@@ -35,14 +35,7 @@ fn benches(c: &mut Criterion) {
             .expect("model");
             let prep = prepare(&model, &sc.waves, sc.history_s).expect("spin-up");
             let mut fc = Forecaster::new();
-            let req = ForecastRequest {
-                x0: &prep.x0,
-                v0: &prep.v0,
-                memory: &prep.memory,
-                waves: &prep.waves,
-                horizon_s: 300.0,
-                ramp_s: 0.0,
-            };
+            let req = prep.request(300.0);
             g.bench_function(format!("{name}_{mname}"), |b| {
                 b.iter(|| fc.forecast(&model, black_box(&req)).map(|f| f.steps).unwrap())
             });

@@ -10,7 +10,7 @@ use shipcast::hydro::check::{self, mode_label};
 use shipcast::hydro::radiation;
 use shipcast::rao::FrequencySolver;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
-use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel};
 use shipcast::scenario::{Scenario, prepare};
 use std::io::Write;
 use std::path::PathBuf;
@@ -424,14 +424,7 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
     let build_s = t_build.elapsed().as_secs_f64();
     let prep = prepare(&model, &sc.waves, sc.history_s).context("spin-up of the history")?;
     let mut fc = Forecaster::new();
-    let req = ForecastRequest {
-        x0: &prep.x0,
-        v0: &prep.v0,
-        memory: &prep.memory,
-        waves: &prep.waves,
-        horizon_s: sc.horizon_s,
-        ramp_s: 0.0,
-    };
+    let req = prep.request(sc.horizon_s);
     let mut times_ms = vec![];
     for _ in 0..args.repeat {
         let t = std::time::Instant::now();

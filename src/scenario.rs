@@ -197,6 +197,20 @@ pub struct Prepared {
     pub waves: Vec<WaveComponent>,
 }
 
+impl Prepared {
+    /// The forecast request from this state, over `horizon_s`.
+    pub fn request(&self, horizon_s: f64) -> ForecastRequest<'_> {
+        ForecastRequest {
+            x0: &self.x0,
+            v0: &self.v0,
+            memory: &self.memory,
+            waves: &self.waves,
+            horizon_s,
+            ramp_s: 0.0,
+        }
+    }
+}
+
 /// Runs the spin-up and returns the state, memory and waves at t0.
 pub fn prepare(model: &TimeModel, waves: &Waves, history_s: f64) -> rom::Result<Prepared> {
     let waves = match waves {
