@@ -158,7 +158,7 @@ impl Stepper {
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
         }
-        self.nonlinear(model, true);
+        quadratic_damping(model, &self.v, &mut self.fnl);
         // M a0 = F - B v - C x - F_nl - F_rad
         for i in 0..n {
             let mut r = f0[i] - frad[i] - self.fnl[i];
@@ -172,18 +172,6 @@ impl Stepper {
         }
         self.p = frad;
         Ok(())
-    }
-
-    /// Quadratic damping at (x, v) when `current`, else at the predicted state (xt, vt).
-    fn nonlinear(&mut self, model: &TimeModel, current: bool) {
-        let n = self.n;
-        self.fnl.iter_mut().for_each(|f| *f = 0.0);
-        if let Some(q) = &model.quadratic {
-            let v = if current { &self.v } else { &self.vt };
-            for i in 0..n {
-                self.fnl[i] = (0..n).map(|j| q[(i, j)] * v[j].abs() * v[j]).sum();
-            }
-        }
     }
 
     /// Advances one step with the wave force `f1` at the new time and the known radiation part `known`:
@@ -234,15 +222,13 @@ impl Stepper {
         }
         let passes = if model.quadratic.is_some() { 2 } else { 1 };
         for pass in 0..passes {
-            if let Some(q) = &model.quadratic {
+            if model.quadratic.is_some() {
                 // quadratic damping at the predicted velocity: first with a_{k+1} = a_k, then corrected
                 let a_guess = if pass == 0 { &self.a } else { &self.a_new };
                 for i in 0..n {
                     self.v_pred[i] = self.vt[i] + 0.5 * dt * a_guess[i];
                 }
-                for i in 0..n {
-                    self.fnl[i] = (0..n).map(|j| q[(i, j)] * self.v_pred[j].abs() * self.v_pred[j]).sum();
-                }
+                quadratic_damping(model, &self.v_pred, &mut self.fnl);
             }
             for i in 0..n {
                 let mut r = f1[i] - self.p[i] - self.fnl[i];
@@ -299,6 +285,19 @@ impl Stepper {
             }
         }
         Ok(())
+    }
+}
+
+/// B_Q |v| v (zero without quadratic damping), into `out`.
+fn quadratic_damping(model: &TimeModel, v: &[f64], out: &mut [f64]) {
+    let n = out.len();
+    match &model.quadratic {
+        Some(q) => {
+            for i in 0..n {
+                out[i] = (0..n).map(|j| q[(i, j)] * v[j].abs() * v[j]).sum();
+            }
+        }
+        None => out.iter_mut().for_each(|f| *f = 0.0),
     }
 }
 
