@@ -432,12 +432,13 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
         times_ms.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let f = fc.forecast(&model, &req)?;
-    let labels: Vec<String> = (0..sys.n_modes()).map(|i| mode_label(sys, i)).collect();
+    let labels: Vec<String> = (0..sys.n_states()).map(|i| mode_label(sys, i)).collect();
+    let extra = shipcast::rom::outputs::derived(&sys.spec.external, f);
     let mut text = String::new();
     match args.format {
         Format::Csv => {
             text.push_str("t_s");
-            for l in &labels {
+            for l in labels.iter().chain(&extra.names) {
                 text.push(',');
                 text.push_str(l);
             }
@@ -447,23 +448,30 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
                 for i in 0..f.n_modes {
                     text.push_str(&format!(",{:.6e}", f.at(k, i)));
                 }
+                for c in 0..extra.names.len() {
+                    text.push_str(&format!(",{:.6e}", extra.at(k, c)));
+                }
                 text.push('\n');
             }
         }
         Format::Json => {
-            let series: Vec<String> = (0..f.n_modes)
-                .map(|i| {
-                    let v: Vec<String> = (0..=f.steps).map(|k| format!("{:.6e}", f.at(k, i))).collect();
-                    format!("\"{}\":[{}]", labels[i], v.join(","))
-                })
-                .collect();
+            let series = |n: usize, name: &dyn Fn(usize) -> String, at: &dyn Fn(usize, usize) -> f64| -> String {
+                (0..n)
+                    .map(|i| {
+                        let v: Vec<String> = (0..=f.steps).map(|k| format!("{:.6e}", at(k, i))).collect();
+                        format!("\"{}\":[{}]", name(i), v.join(","))
+                    })
+                    .collect::<Vec<_>>()
+                    .join(",")
+            };
+            let motion = series(f.n_modes, &|i| labels[i].clone(), &|k, i| f.at(k, i));
+            let derived = series(extra.names.len(), &|c| extra.names[c].clone(), &|k, c| extra.at(k, c));
             text.push_str(&format!(
-                "{{\"dt_s\":{},\"horizon_s\":{},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{}}}}}\n",
+                "{{\"dt_s\":{},\"horizon_s\":{},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{motion}}},\"points\":{{{derived}}}}}\n",
                 f.dt_s,
                 f.steps as f64 * f.dt_s,
                 sc.opts.radiation,
                 f.skipped_components,
-                series.join(",")
             ));
         }
     }

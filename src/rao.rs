@@ -6,7 +6,9 @@
 //! 6N-vector Xi is for exp(+i w t) and a unit-amplitude wave whose crest is at the database origin at
 //! t = 0; |Xi_i| is in m/m for translations and rad/m for rotations. A(w), B(w) and X(w, beta) are
 //! interpolated by [`crate::hydro::HydroDb`]. Quadratic damping does not enter (it has no linear
-//! frequency-domain form); zero forward speed.
+//! frequency-domain form); zero forward speed. External models enter as the system file gives them:
+//! tanks (one state each after the 6N modes), linear connections, and the nonlinear connections
+//! linearized at equilibrium (their tangent stiffness by central differences).
 
 use crate::hydro::{Error, Result, VesselSystem};
 use nalgebra::{DMatrix, DVector};
@@ -24,16 +26,17 @@ pub struct FrequencySolver<'a> {
 
 impl<'a> FrequencySolver<'a> {
     pub fn new(sys: &'a VesselSystem) -> Self {
+        let terms = sys.linear_terms();
         FrequencySolver {
             sys,
-            mass: sys.mass_matrix(),
-            damping: sys.linear_damping(),
-            stiffness: sys.stiffness(),
-            active: sys.active_indices(),
+            mass: terms.mass,
+            damping: terms.damping,
+            stiffness: terms.stiffness + sys.spec.external.nonlinear_tangent(sys.n_states()),
+            active: sys.active_states(),
         }
     }
 
-    /// Motion RAO of every mode (inactive ones zero) at `omega_rad_s` and `heading_rad`.
+    /// Motion RAO of every state (6N modes then the tanks; inactive ones zero) at `omega_rad_s` and `heading_rad`.
     pub fn rao(&self, omega_rad_s: f64, heading_rad: f64) -> Result<DVector<Complex64>> {
         if !(omega_rad_s.is_finite() && omega_rad_s > 0.0) {
             return Err(Error::OutOfRange(format!(
@@ -45,19 +48,21 @@ impl<'a> FrequencySolver<'a> {
         let w = omega_rad_s;
         let act = &self.active;
         let na = act.len();
+        let nm = self.sys.n_modes();
+        let hydro = |m: &DMatrix<f64>, i: usize, j: usize| if i < nm && j < nm { m[(i, j)] } else { 0.0 };
         let z = DMatrix::from_fn(na, na, |r, c| {
             let (i, j) = (act[r], act[c]);
             Complex64::new(
-                -w * w * (self.mass[(i, j)] + a[(i, j)]) + self.stiffness[(i, j)],
-                w * (b[(i, j)] + self.damping[(i, j)]),
+                -w * w * (self.mass[(i, j)] + hydro(&a, i, j)) + self.stiffness[(i, j)],
+                w * (hydro(&b, i, j) + self.damping[(i, j)]),
             )
         });
-        let rhs = DVector::from_fn(na, |r, _| x[act[r]]);
+        let rhs = DVector::from_fn(na, |r, _| if act[r] < nm { x[act[r]] } else { Complex64::default() });
         let sol = z
             .lu()
             .solve(&rhs)
             .ok_or_else(|| Error::OutOfRange(format!("the equations of motion are singular at {w} rad/s")))?;
-        let mut out = DVector::from_element(self.sys.n_modes(), Complex64::default());
+        let mut out = DVector::from_element(self.sys.n_states(), Complex64::default());
         for (r, &i) in act.iter().enumerate() {
             out[i] = sol[r];
         }

@@ -11,3 +11,4 @@ mod forecast_cli;
 mod kramers_kronig;
 mod rom;
 mod wecsim_rm3;
+mod wecsim_rm3_3dof;

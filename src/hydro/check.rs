@@ -141,6 +141,11 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
 
 /// `carrier.heave` style label of a 0-based global mode index.
 pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
+    if i >= sys.n_modes() {
+        let k = i - sys.n_modes();
+        let name = sys.spec.external.tank_names.get(k).map(|s| s.as_str()).unwrap_or("?");
+        return format!("{name}.tank_angle");
+    }
     let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
     format!("{body}.{}", Dof::of_index(i).name())
 }

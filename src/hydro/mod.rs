@@ -16,6 +16,7 @@
 
 pub mod check;
 pub mod db;
+pub mod external;
 pub mod radiation;
 pub mod statespace;
 pub mod system;

@@ -10,6 +10,7 @@
 //! (C_UQ) per (m/s)^2 of forward speed.
 
 use super::db::HydroDb;
+use super::external::{self, External};
 use super::wamit::{Excitation, Radiation};
 use super::{Dof, Error, Result};
 use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3};
@@ -53,6 +54,14 @@ struct SystemFile {
     #[serde(default)]
     linear_stiffness_entries: Vec<[f64; 3]>,
     body: Vec<BodyFile>,
+    #[serde(default)]
+    connection: Vec<external::ConnectionFile>,
+    #[serde(default)]
+    tank: Vec<external::TankFile>,
+    #[serde(default)]
+    point: Vec<external::PointFile>,
+    #[serde(default)]
+    relative_motion: Vec<external::RelativeFile>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -69,6 +78,14 @@ fn yes() -> bool {
     true
 }
 
+/// A 6 x 6 matrix, or its diagonal as 6 numbers.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum MatrixOrDiagonal {
+    Matrix(Box<[[f64; 6]; 6]>),
+    Diagonal([f64; 6]),
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct BodyFile {
@@ -79,7 +96,8 @@ struct BodyFile {
     centre_of_gravity: Option<[f64; 3]>,
     radii_of_gyration: Option<[f64; 3]>,
     linear_damping: Option<[[f64; 6]; 6]>,
-    quadratic_damping: Option<[[f64; 6]; 6]>,
+    linear_stiffness: Option<[[f64; 6]; 6]>,
+    quadratic_damping: Option<MatrixOrDiagonal>,
     speed_damping: Option<[[f64; 6]; 6]>,
     speed_restoring: Option<[[f64; 6]; 6]>,
     active_dofs: Option<Vec<String>>,
@@ -113,6 +131,8 @@ pub struct Body {
     pub mass: Matrix6<f64>,
     /// Added to B_lin.
     pub linear_damping: Matrix6<f64>,
+    /// External linear stiffness (a linearized mooring, a PTO spring), added to C.
+    pub linear_stiffness: Matrix6<f64>,
     /// B_Q in B_Q |x'| x'.
     pub quadratic_damping: Matrix6<f64>,
     /// B_U in B_U U x' (damping per m/s of forward speed).
@@ -141,6 +161,8 @@ pub struct SystemSpec {
     pub extra_damping: DMatrix<f64>,
     /// 6N x 6N, added to C.
     pub extra_stiffness: DMatrix<f64>,
+    /// Connections, tanks, points of interest ([`super::external`]).
+    pub external: External,
 }
 
 impl SystemSpec {
@@ -230,6 +252,18 @@ impl SystemSpec {
         };
         let extra_damping = extra("linear_damping_entries", &raw.linear_damping_entries)?;
         let extra_stiffness = extra("linear_stiffness_entries", &raw.linear_stiffness_entries)?;
+        let names: Vec<String> = bodies.iter().map(|b| b.name.clone()).collect();
+        let positions = bodies.iter().map(|b| b.position_m).collect();
+        let external = external::parse_external(
+            &raw.connection,
+            &raw.tank,
+            &raw.point,
+            &raw.relative_motion,
+            &names,
+            positions,
+            raw.g,
+        )
+        .map_err(|(k, msg)| key(&k, msg))?;
         Ok(SystemSpec {
             wamit_stem: raw.wamit,
             ulen_m: raw.ulen,
@@ -242,6 +276,7 @@ impl SystemSpec {
             bodies,
             extra_damping,
             extra_stiffness,
+            external,
         })
     }
 }
@@ -345,7 +380,34 @@ fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
         Some(m) => finite_matrix(m, field),
         None => Ok(Matrix6::zeros()),
     };
-    let quadratic_damping = optional(&b.quadratic_damping, "quadratic_damping")?;
+    let quadratic_damping = match &b.quadratic_damping {
+        Some(MatrixOrDiagonal::Matrix(m)) => finite_matrix(m.as_ref(), "quadratic_damping")?,
+        Some(MatrixOrDiagonal::Diagonal(d)) => {
+            let mut m = [[0.0; 6]; 6];
+            for i in 0..6 {
+                m[i][i] = d[i];
+            }
+            finite_matrix(&m, "quadratic_damping")?
+        }
+        None => Matrix6::zeros(),
+    };
+    let linear_stiffness = optional(&b.linear_stiffness, "linear_stiffness")?;
+    for (m, field) in [
+        (&linear_damping, "linear_damping"),
+        (&quadratic_damping, "quadratic_damping"),
+        (&linear_stiffness, "linear_stiffness"),
+    ] {
+        if let Some(i) = (0..6).find(|&i| m[(i, i)] < 0.0) {
+            return Err(err(
+                field,
+                format!(
+                    "diagonal entry {i} ({}) is negative: {} (it would feed energy in)",
+                    Dof::ALL[i].name(),
+                    m[(i, i)]
+                ),
+            ));
+        }
+    }
     let speed_damping = optional(&b.speed_damping, "speed_damping")?;
     let speed_restoring = optional(&b.speed_restoring, "speed_restoring")?;
     let mut active = [true; 6];
@@ -366,11 +428,20 @@ fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
         position_m: Vector3::from(b.position),
         mass,
         linear_damping,
+        linear_stiffness,
         quadratic_damping,
         speed_damping,
         speed_restoring,
         active,
     })
+}
+
+/// Linear terms over every state (see [`VesselSystem::linear_terms`]).
+#[derive(Debug, Clone)]
+pub struct LinearTerms {
+    pub mass: DMatrix<f64>,
+    pub damping: DMatrix<f64>,
+    pub stiffness: DMatrix<f64>,
 }
 
 /// A vessel system: bodies, their hydrodynamic database and system-level terms, ready for the solvers.
@@ -415,7 +486,26 @@ impl VesselSystem {
         if asym > 1e-6 * c.amax() {
             warnings.push(format!("the restoring matrix is not symmetric (largest |C_ij - C_ji| = {asym:.4e}): is the body in equilibrium?"));
         }
-        Ok(VesselSystem { spec, db, warnings })
+        let sys = VesselSystem { spec, db, warnings };
+        // a tank's free-surface effect must leave the roll restoring positive
+        let c = sys.stiffness();
+        for (k, t) in sys.spec.external.tanks.iter().enumerate() {
+            let r = 6 * t.body + 3;
+            let left = c[(r, r)] - t.c_t4 * t.c_t4 / t.c_tt;
+            if left <= 0.0 {
+                return Err(Error::Key {
+                    file: file.into(),
+                    key: format!("tank[{k}]"),
+                    msg: format!(
+                        "the tank's free-surface effect c_t4^2 / c_tt = {:.4e} N m exceeds the roll restoring {:.4e} N m of `{}`: the ship would capsize",
+                        t.c_t4 * t.c_t4 / t.c_tt,
+                        c[(r, r)],
+                        sys.spec.bodies[t.body].name
+                    ),
+                });
+            }
+        }
+        Ok(sys)
     }
 
     pub fn n_modes(&self) -> usize {
@@ -437,9 +527,51 @@ impl VesselSystem {
         self.block_diag(f)
     }
 
-    /// C: the database's restoring plus system-level stiffness entries.
+    /// C: the database's restoring plus the bodies' external stiffness and system-level entries.
     pub fn stiffness(&self) -> DMatrix<f64> {
-        &self.db.restoring + &self.spec.extra_stiffness
+        &self.db.restoring + &self.spec.extra_stiffness + self.block_diag(|b| &b.linear_stiffness)
+    }
+
+    /// Number of states: the 6N body modes, then one per anti-roll tank.
+    pub fn n_states(&self) -> usize {
+        self.n_modes() + self.spec.external.tanks.len()
+    }
+
+    /// Active DOFs followed by every tank state (indices into the n_states vector).
+    pub fn active_states(&self) -> Vec<usize> {
+        let mut a = self.active_indices();
+        a.extend(self.n_modes()..self.n_states());
+        a
+    }
+
+    /// The speed-independent linear terms over every state (n_states x n_states): mass (rigid body +
+    /// tanks), damping (B_lin + linear connections + tanks), stiffness (C + external + linear
+    /// connections + tanks). Hydrodynamic terms (A, B, A_inf, K) are not included.
+    pub fn linear_terms(&self) -> LinearTerms {
+        let ns = self.n_states();
+        let n = self.n_modes();
+        let pad = |m: DMatrix<f64>| {
+            let mut out = DMatrix::zeros(ns, ns);
+            out.view_mut((0, 0), (n, n)).copy_from(&m);
+            out
+        };
+        let ext = &self.spec.external;
+        let [tm, tb, tc] = ext.tank_matrices(n);
+        let (kc, cc) = ext.linear_matrices(ns);
+        LinearTerms {
+            mass: pad(self.mass_matrix()) + tm,
+            damping: pad(self.linear_damping()) + tb + cc,
+            stiffness: pad(self.stiffness()) + tc + kc,
+        }
+    }
+
+    /// A hydrodynamic n_modes matrix padded with zeros to n_states.
+    pub fn pad_states(&self, m: &DMatrix<f64>) -> DMatrix<f64> {
+        let ns = self.n_states();
+        let mut out = DMatrix::zeros(ns, ns);
+        let n = m.nrows().min(ns);
+        out.view_mut((0, 0), (n, n)).copy_from(&m.view((0, 0), (n, n)));
+        out
     }
 
     /// Indices (0-based, global) of the active DOFs.

@@ -27,7 +27,8 @@ pub struct ForecastRequest<'a> {
     pub ramp_s: f64,
 }
 
-/// A forecast: every mode (inactive ones zero) on t = t0 + k dt, k = 0..steps.
+/// A forecast: every state (6N body modes then the tanks; inactive ones zero) on t = t0 + k dt,
+/// k = 0..steps. Points, relative motions and connection forces: [`super::outputs`].
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Forecast {
     pub dt_s: f64,
@@ -37,6 +38,8 @@ pub struct Forecast {
     pub x: Vec<f64>,
     /// v[k * n_modes + i], m/s or rad/s.
     pub v: Vec<f64>,
+    /// a[k * n_modes + i], m/s^2 or rad/s^2.
+    pub a: Vec<f64>,
     /// Components outside the database (frequency or heading) and left out.
     pub skipped_components: usize,
     /// Their share of the field's variance, sum |a|^2 / 2.
@@ -199,9 +202,12 @@ impl Forecaster {
         self.out.x.resize((steps + 1) * nm, 0.0);
         self.out.v.clear();
         self.out.v.resize((steps + 1) * nm, 0.0);
+        self.out.a.clear();
+        self.out.a.resize((steps + 1) * nm, 0.0);
         for (r, &i) in model.active.iter().enumerate() {
             self.out.x[i] = req.x0[r];
             self.out.v[i] = req.v0[r];
+            self.out.a[i] = self.stepper.a[r];
         }
         let blocked = matches!(model.kernel, Kernel::Convolution { .. }) && steps > 2 * CONV_BLOCK;
         let mut direct_from = 1;
@@ -212,6 +218,7 @@ impl Forecaster {
             for (r, &i) in model.active.iter().enumerate() {
                 self.out.x[k * nm + i] = self.stepper.x[r];
                 self.out.v[k * nm + i] = self.stepper.v[r];
+                self.out.a[k * nm + i] = self.stepper.a[r];
             }
             if blocked && k % CONV_BLOCK == 0 && k < steps {
                 self.block_part(model, k + 1 - CONV_BLOCK, steps)?;

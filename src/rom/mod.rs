@@ -14,7 +14,12 @@
 //! the undamped part, stable for w dt < 2.45), fixed step dt. The radiation force at the new step is
 //! split into what is known (history) and an instantaneous part D v_{k+1} folded into the implicit
 //! matrix, so one radiation evaluation per step suffices and nothing is frozen. Nonlinear forces
-//! (quadratic damping) are evaluated at a predicted state and corrected once.
+//! (quadratic damping, mooring lines, fenders) are iterated to convergence within each step
+//! (fixed point on the new acceleration; see [`stepper::NL_TOLERANCE`]).
+//!
+//! External models ([`crate::hydro::external`]): linear connections and per-body external stiffness
+//! and damping are in C and B_lin; each anti-roll tank adds a state after the active body DOFs;
+//! lines and fenders are nonlinear forces relative to their equilibrium value.
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
 //! reference) or the passive state-space fit ([`crate::hydro::statespace`]) with its exact discrete
@@ -23,6 +28,7 @@
 pub mod forecast;
 pub mod memory;
 pub mod model;
+pub mod outputs;
 pub mod regular;
 pub mod stepper;
 

@@ -5,16 +5,19 @@ use crate::hydro::check::active_radiation;
 use crate::hydro::radiation::{self, default_duration_s};
 use crate::hydro::statespace::{self, DiscreteTerm, SsFitOptions, SsModel};
 use crate::hydro::system::AInfSource;
-use crate::hydro::{Dof, HydroDb, VesselSystem};
+use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
 
 /// How the radiation memory is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum RadiationMethod {
     /// Direct convolution of K with the velocity history (the reference).
     Convolution,
     /// The passive state-space fit with its exact discrete update.
     StateSpace,
+    /// No memory: A(w) and B(w) of one frequency as constant coefficients (WEC-Sim's `regular` runs;
+    /// right only in a regular wave of that frequency, after the transient).
+    Constant { omega_rad_s: f64 },
 }
 
 /// Integration parameters (plain `Copy`; every field documents unit and default).
@@ -71,6 +74,14 @@ pub struct Channel {
     pub c_g1: f64,
 }
 
+/// Scratch for [`TimeModel::nonlinear_force`].
+#[derive(Debug, Clone, Default)]
+pub struct NlScratch {
+    x: Vec<f64>,
+    v: Vec<f64>,
+    f: Vec<f64>,
+}
+
 /// Eigenvalues of a term's gain below this fraction of the model's largest (scaled) are dropped.
 pub const CHANNEL_CUTOFF: f64 = 1e-4;
 
@@ -78,7 +89,9 @@ pub const CHANNEL_CUTOFF: f64 = 1e-4;
 /// order of `active` (global 0-based mode indices).
 #[derive(Debug, Clone)]
 pub struct TimeModel {
+    /// Number of states: 6N body modes then one per tank.
     pub n_modes: usize,
+    /// Active states (global indices): the active body DOFs, then every tank.
     pub active: Vec<usize>,
     /// `body.dof` label of each active DOF.
     pub labels: Vec<String>,
@@ -93,6 +106,12 @@ pub struct TimeModel {
     pub stiffness: DMatrix<f64>,
     /// B_Q, when any entry is non-zero.
     pub quadratic: Option<DMatrix<f64>>,
+    /// The nonlinear connections (mooring lines, fenders), when there are any.
+    pub external: Option<crate::hydro::external::External>,
+    /// Their generalized force at equilibrium (n_modes), subtracted (see [`crate::hydro::external`]).
+    pub nl_offset: Vec<f64>,
+    /// Number of active body DOFs: they come first in `active`, the tank states after them.
+    pub n_hydro: usize,
     pub kernel: Kernel,
     /// Instantaneous radiation matrix D: F_rad(t_k+1) = P + D v_k+1.
     pub d_inst: DMatrix<f64>,
@@ -117,11 +136,18 @@ impl TimeModel {
         if !opts.speed_m_s.is_finite() {
             return Err(Error::Input("forward speed must be finite".into()));
         }
-        let active = sys.active_indices();
-        if active.is_empty() {
+        let active = sys.active_states();
+        let nh = sys.active_indices().len();
+        if nh == 0 {
             return Err(Error::Input("no active DOF in the system".into()));
         }
         let n = active.len();
+        let nm = sys.n_modes();
+        // hydrodynamic matrices are n_modes x n_modes: zero beyond (tank states)
+        let hyd = |m: &DMatrix<f64>, r: usize, c: usize| {
+            let (i, j) = (active[r], active[c]);
+            if i < nm && j < nm { m[(i, j)] } else { 0.0 }
+        };
         let sub = |m: &DMatrix<f64>| DMatrix::from_fn(n, n, |r, c| m[(active[r], active[c])]);
         let dt = opts.dt_s;
         let u = opts.speed_m_s;
@@ -139,12 +165,27 @@ impl TimeModel {
             (Some(AInfSource::Database), Some(a)) => a.clone(),
             _ => radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, &irf_all)),
         };
-        let mut mass = sub(&(sys.mass_matrix() + &a_inf_all));
-        let damping = sub(&(sys.linear_damping() + sys.body_matrix(|b| &b.speed_damping) * u));
-        let stiffness = sub(&(sys.stiffness() + sys.body_matrix(|b| &b.speed_restoring) * (u * u)));
-        let q = sub(&sys.body_matrix(|b| &b.quadratic_damping));
+        let terms = sys.linear_terms();
+        let pad = |m: &DMatrix<f64>| sys.pad_states(m);
+        let mut mass = sub(&(&terms.mass + pad(&a_inf_all)));
+        let damping = sub(&(&terms.damping + pad(&(sys.body_matrix(|b| &b.speed_damping) * u))));
+        let stiffness = sub(&(&terms.stiffness + pad(&(sys.body_matrix(|b| &b.speed_restoring) * (u * u)))));
+        let q = sub(&pad(&sys.body_matrix(|b| &b.quadratic_damping)));
         let quadratic = if q.iter().any(|v| *v != 0.0) { Some(q) } else { None };
+        let mut damping = damping;
         let (kernel, d_inst) = match opts.radiation {
+            RadiationMethod::Constant { omega_rad_s } => {
+                let (a, b) = sys.db.radiation_at(omega_rad_s)?;
+                mass = sub(&(&terms.mass + pad(&a)));
+                damping += sub(&pad(&b));
+                (
+                    Kernel::Convolution {
+                        taps: 1,
+                        k: vec![0.0; n * n],
+                    },
+                    DMatrix::zeros(n, n),
+                )
+            }
             RadiationMethod::Convolution => {
                 let taps = irf_all.k.len();
                 let mut k = vec![0.0; n * taps * n];
@@ -152,7 +193,7 @@ impl TimeModel {
                     let w = if m == 0 || m + 1 == taps { 0.5 } else { 1.0 };
                     for i in 0..n {
                         for j in 0..n {
-                            k[(i * taps + m) * n + j] = dt * w * km[(active[i], active[j])];
+                            k[(i * taps + m) * n + j] = dt * w * hyd(km, i, j);
                         }
                     }
                 }
@@ -175,7 +216,7 @@ impl TimeModel {
                 let eigs: Vec<_> = model
                     .terms
                     .iter()
-                    .map(|t| DMatrix::from_fn(n, n, |i, j| t.gain[(i, j)] / (scale[i] * scale[j])).symmetric_eigen())
+                    .map(|t| DMatrix::from_fn(nh, nh, |i, j| t.gain[(i, j)] / (scale[i] * scale[j])).symmetric_eigen())
                     .collect();
                 let top = eigs
                     .iter()
@@ -195,7 +236,16 @@ impl TimeModel {
                         if *lam <= CHANNEL_CUTOFF * top {
                             continue;
                         }
-                        let u: Vec<f64> = (0..n).map(|i| e.eigenvectors[(i, l)] * lam.sqrt() * scale[i]).collect();
+                        // tank states (after the nh hydrodynamic ones) do not radiate
+                        let u: Vec<f64> = (0..n)
+                            .map(|i| {
+                                if i < nh {
+                                    e.eigenvectors[(i, l)] * lam.sqrt() * scale[i]
+                                } else {
+                                    0.0
+                                }
+                            })
+                            .collect();
                         for i in 0..n {
                             for j in 0..n {
                                 d[(i, j)] += c_g1 * u[i] * u[j];
@@ -220,7 +270,9 @@ impl TimeModel {
                     .map(|(w, a)| a - model.kernel(*w).map(|c| c.im / w))
                     .collect();
                 let a_inf_ss = radiation::ogilvie_a_inf(&estimates);
-                mass = sub(&sys.mass_matrix()) + a_inf_ss;
+                mass = sub(&terms.mass);
+                let mut top = mass.view_mut((0, 0), (nh, nh));
+                top += &a_inf_ss;
                 (Kernel::StateSpace { model, channels }, d)
             }
         };
@@ -228,17 +280,15 @@ impl TimeModel {
         let s_inv = s
             .try_inverse()
             .ok_or_else(|| Error::Input("the implicit step matrix is singular (no mass on an active DOF?)".into()))?;
-        let labels = active
-            .iter()
-            .map(|&i| {
-                let body = &sys.spec.bodies[i / 6].name;
-                format!("{body}.{}", Dof::of_index(i).name())
-            })
-            .collect();
         let irf = match opts.radiation {
+            RadiationMethod::Constant { .. } => None,
             RadiationMethod::Convolution => Some(radiation::Irf {
                 dt_s: dt,
-                k: irf_all.k.iter().map(&sub).collect(),
+                k: irf_all
+                    .k
+                    .iter()
+                    .map(|km| DMatrix::from_fn(n, n, |r, c| hyd(km, r, c)))
+                    .collect(),
             }),
             RadiationMethod::StateSpace => None,
         };
@@ -246,8 +296,27 @@ impl TimeModel {
             .clone()
             .try_inverse()
             .ok_or_else(|| Error::Input("the mass matrix M + A_inf is singular".into()))?;
+        if mass.clone().cholesky().is_none() {
+            return Err(Error::Input(
+                "M + A_inf (with the tanks' fluid) is not positive definite: check the tank coefficients a_tt, a_t4"
+                    .into(),
+            ));
+        }
+        let external = sys.spec.external.has_nonlinear().then(|| sys.spec.external.clone());
+        let mut nl_offset = vec![0.0; sys.n_states()];
+        if let Some(e) = &external {
+            let z = vec![0.0; sys.n_states()];
+            e.nonlinear_force(&z, &z, &mut nl_offset);
+        }
+        let labels = active
+            .iter()
+            .map(|&i| crate::hydro::check::mode_label(sys, i))
+            .collect();
         Ok(TimeModel {
-            n_modes: sys.n_modes(),
+            n_modes: sys.n_states(),
+            n_hydro: nh,
+            external,
+            nl_offset,
             active,
             labels,
             opts,
@@ -270,7 +339,17 @@ impl TimeModel {
     /// transform of the sampled K (linear between samples), or the state-space model's kernel.
     pub fn kernel_at(&self, omega_rad_s: f64) -> DMatrix<num_complex::Complex64> {
         match (&self.kernel, &self.irf) {
-            (Kernel::StateSpace { model, .. }, _) => model.kernel(omega_rad_s),
+            (Kernel::StateSpace { model, .. }, _) => {
+                let k = model.kernel(omega_rad_s);
+                let nh = self.n_hydro;
+                DMatrix::from_fn(self.n(), self.n(), |i, j| {
+                    if i < nh && j < nh {
+                        k[(i, j)]
+                    } else {
+                        num_complex::Complex64::default()
+                    }
+                })
+            }
             (_, Some(irf)) => {
                 let c = radiation::transform_irf(irf, &[omega_rad_s], false);
                 let s = radiation::transform_irf(irf, &[omega_rad_s], true);
@@ -289,7 +368,8 @@ impl TimeModel {
         use num_complex::Complex64;
         let n = self.n();
         let mut x = vec![Complex64::default(); self.n_modes];
-        self.db.excitation_into(omega_rad_s, heading_rad, &mut x)?;
+        let nm = self.db.n_modes;
+        self.db.excitation_into(omega_rad_s, heading_rad, &mut x[..nm])?;
         let k = self.kernel_at(omega_rad_s);
         let w = omega_rad_s;
         let z = DMatrix::from_fn(n, n, |i, j| {
@@ -310,7 +390,42 @@ impl TimeModel {
         Ok(out)
     }
 
-    /// Number of active DOFs.
+    /// True when the equations have nonlinear terms (quadratic damping, lines, fenders).
+    pub fn is_nonlinear(&self) -> bool {
+        self.quadratic.is_some() || self.external.is_some()
+    }
+
+    /// The nonlinear forces at the active states x, v (B_Q |v| v plus the connections' force relative
+    /// to equilibrium, as a load on the left-hand side: the negative of the connection force), into
+    /// `out`; `ws` is scratch.
+    pub fn nonlinear_force(&self, x: &[f64], v: &[f64], out: &mut [f64], ws: &mut NlScratch) {
+        let n = out.len();
+        match &self.quadratic {
+            Some(q) => {
+                for i in 0..n {
+                    out[i] = (0..n).map(|j| q[(i, j)] * v[j].abs() * v[j]).sum();
+                }
+            }
+            None => out.iter_mut().for_each(|f| *f = 0.0),
+        }
+        if let Some(e) = &self.external {
+            let nm = self.n_modes;
+            for b in [&mut ws.x, &mut ws.v, &mut ws.f] {
+                b.clear();
+                b.resize(nm, 0.0);
+            }
+            for (r, &i) in self.active.iter().enumerate() {
+                ws.x[i] = x[r];
+                ws.v[i] = v[r];
+            }
+            e.nonlinear_force(&ws.x, &ws.v, &mut ws.f);
+            for (r, &i) in self.active.iter().enumerate() {
+                out[r] -= ws.f[i] - self.nl_offset[i];
+            }
+        }
+    }
+
+    /// Number of active states.
     pub fn n(&self) -> usize {
         self.active.len()
     }

@@ -58,7 +58,7 @@ pub fn time_domain_rao(
             settled_s: 0.0,
         });
     }
-    if model.quadratic.is_none() {
+    if !model.is_nonlinear() {
         return run(model, heading_rad, omegas_rad_s, opts);
     }
     let mut out = TimeRao {

@@ -3,7 +3,7 @@
 //! The stepper owns only reusable workspace; what it reads comes in as arguments.
 
 use super::memory::{Memory, advance_states, update_channel};
-use super::model::{Kernel, TimeModel};
+use super::model::{Kernel, NlScratch, TimeModel};
 use super::{Error, Result};
 
 /// Displacement beyond which a state counts as unbounded (m or rad).
@@ -35,7 +35,17 @@ pub struct Stepper {
     w: Vec<f64>,
     v_new: Vec<f64>,
     v_pred: Vec<f64>,
+    x_pred: Vec<f64>,
+    nl: NlScratch,
+    /// Fixed-point passes of the nonlinear forces taken by the last step.
+    pub passes: usize,
 }
+
+/// Nonlinear forces (quadratic damping, lines, fenders) are iterated at each step until the new
+/// acceleration changes by less than this fraction of its largest entry...
+pub const NL_TOLERANCE: f64 = 1e-10;
+/// ... or for at most this many passes (each pass is one force evaluation and one n x n product).
+pub const NL_MAX_PASSES: usize = 12;
 
 impl Stepper {
     pub fn new() -> Self {
@@ -64,6 +74,7 @@ impl Stepper {
                 &mut self.a_new,
                 &mut self.v_new,
                 &mut self.v_pred,
+                &mut self.x_pred,
             ] {
                 v.resize(n, 0.0);
             }
@@ -158,7 +169,7 @@ impl Stepper {
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
         }
-        quadratic_damping(model, &self.v, &mut self.fnl);
+        model.nonlinear_force(&self.x, &self.v, &mut self.fnl, &mut self.nl);
         // M a0 = F - B v - C x - F_nl - F_rad
         for i in 0..n {
             let mut r = f0[i] - frad[i] - self.fnl[i];
@@ -220,15 +231,21 @@ impl Stepper {
             self.xt[i] = self.x[i] + dt * self.v[i] + dt * dt * (0.5 - beta) * self.a[i];
             self.vt[i] = self.v[i] + 0.5 * dt * self.a[i];
         }
-        let passes = if model.quadratic.is_some() { 2 } else { 1 };
-        for pass in 0..passes {
-            if model.quadratic.is_some() {
-                // quadratic damping at the predicted velocity: first with a_{k+1} = a_k, then corrected
-                let a_guess = if pass == 0 { &self.a } else { &self.a_new };
+        // nonlinear forces at the state the new acceleration implies: fixed-point passes starting from
+        // a_{k+1} = a_k (they contract fast: the step matrix S is dominated by the mass)
+        let nonlinear = model.is_nonlinear();
+        if !nonlinear {
+            self.fnl.iter_mut().for_each(|f| *f = 0.0);
+        }
+        self.a_new.copy_from_slice(&self.a);
+        self.passes = 0;
+        loop {
+            if nonlinear {
                 for i in 0..n {
-                    self.v_pred[i] = self.vt[i] + 0.5 * dt * a_guess[i];
+                    self.v_pred[i] = self.vt[i] + 0.5 * dt * self.a_new[i];
+                    self.x_pred[i] = self.xt[i] + beta * dt * dt * self.a_new[i];
                 }
-                quadratic_damping(model, &self.v_pred, &mut self.fnl);
+                model.nonlinear_force(&self.x_pred, &self.v_pred, &mut self.fnl, &mut self.nl);
             }
             for i in 0..n {
                 let mut r = f1[i] - self.p[i] - self.fnl[i];
@@ -238,8 +255,16 @@ impl Stepper {
                 }
                 self.rhs[i] = r;
             }
+            let (mut change, mut size) = (0.0f64, 0.0f64);
             for i in 0..n {
-                self.a_new[i] = (0..n).map(|j| model.s_inv[(i, j)] * self.rhs[j]).sum();
+                let a: f64 = (0..n).map(|j| model.s_inv[(i, j)] * self.rhs[j]).sum();
+                change = change.max((a - self.a_new[i]).abs());
+                size = size.max(a.abs());
+                self.a_new[i] = a;
+            }
+            self.passes += 1;
+            if !nonlinear || change <= NL_TOLERANCE * size || self.passes >= NL_MAX_PASSES {
+                break;
             }
         }
         for i in 0..n {
@@ -285,19 +310,6 @@ impl Stepper {
             }
         }
         Ok(())
-    }
-}
-
-/// B_Q |v| v (zero without quadratic damping), into `out`.
-fn quadratic_damping(model: &TimeModel, v: &[f64], out: &mut [f64]) {
-    let n = out.len();
-    match &model.quadratic {
-        Some(q) => {
-            for i in 0..n {
-                out[i] = (0..n).map(|j| q[(i, j)] * v[j].abs() * v[j]).sum();
-            }
-        }
-        None => out.iter_mut().for_each(|f| *f = 0.0),
     }
 }
 
