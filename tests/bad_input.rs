@@ -178,3 +178,55 @@ mod never_panics {
         }
     }
 }
+
+/// Appends a section to the one-ship system file and expects `db check` to refuse it.
+fn refuses_section(section: &str, want: &[&str]) {
+    let d = scratch_copy();
+    edit(&d.join("system.toml"), |t| format!("{t}\n{section}"));
+    expect_error(&d, want);
+}
+
+const SPRING: &str = "[[connection]]\nname = \"pto\"\nkind = \"spring_damper\"\nbody_a = \"carrier\"\npoint_a_m = [0.0, 0.0, 0.0]\nbody_b = \"earth\"\npoint_b_m = [0.0, 0.0, -50.0]\n";
+
+#[test]
+fn negative_connection_stiffness() {
+    refuses_section(
+        &format!("{SPRING}stiffness_n_m = -1.0e5\n"),
+        &[
+            "connection[0].stiffness_n_m",
+            "must be a finite number >= 0, found -100000",
+        ],
+    );
+}
+
+#[test]
+fn fender_curve_that_is_not_monotonic() {
+    refuses_section(
+        "[[connection]]\nname = \"f\"\nkind = \"fender\"\nbody_a = \"carrier\"\npoint_a_m = [0.0, 15.0, 0.0]\nbody_b = \"earth\"\npoint_b_m = [0.0, 16.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\ncurve = [[0.5, 3.0e5], [1.0, 2.0e5]]\n",
+        &["connection[0].curve", "not monotonic"],
+    );
+}
+
+#[test]
+fn point_on_an_unknown_body() {
+    refuses_section(
+        "[[point]]\nname = \"crane_tip\"\nbody = \"barge\"\nposition_m = [0.0, 10.0, 25.0]\n",
+        &["point[0].body", "names no body: `barge`", "carrier"],
+    );
+}
+
+#[test]
+fn key_of_another_connection_kind() {
+    refuses_section(
+        &format!("{SPRING}normal = [0.0, 1.0, 0.0]\n"),
+        &["connection[0].normal", "is not a key of a `spring_damper` connection"],
+    );
+}
+
+#[test]
+fn tank_that_capsizes_the_ship() {
+    refuses_section(
+        "[[tank]]\nname = \"art\"\nbody = \"carrier\"\na_tt = 1.0e8\nc_tt = 1.0e9\na_t4 = 1.0e7\nc_t4 = 1.0e9\n",
+        &["tank[0]", "exceeds the roll restoring"],
+    );
+}

@@ -72,3 +72,39 @@ fn a_scenario_with_sea_and_components_is_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn moored_forecast_has_points_relative_motions_and_connection_forces() {
+    let (ok, out, err) = shipcast(&["forecast", "config/scenarios/two-ship-moored.toml", "--horizon", "30"]);
+    assert!(ok, "{err}");
+    let mut lines = out.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for want in [
+        "lighter.roll",
+        "crane_tip.z",
+        "crane_tip.vz",
+        "crane_tip.az",
+        "hook_over_hatch.y",
+        "fender_aft.force",
+        "head_line.force",
+    ] {
+        assert!(header.contains(&want), "no column {want} in {header:?}");
+    }
+    let rows: Vec<Vec<f64>> = lines
+        .filter(|l| !l.is_empty())
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 301);
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    // the relative motion is the difference of the two points
+    for r in &rows {
+        let rel = r[col("hook_over_hatch.y")];
+        let (a, b) = (r[col("crane_tip.y")], r[col("lighter_hatch.y")]);
+        // printed with 7 significant digits
+        assert!(
+            (rel - (a - b)).abs() <= 1e-6 * (a.abs() + b.abs()) + 1e-12,
+            "{rel} vs {a} - {b}"
+        );
+        assert!(r[col("fender_aft.force")] >= 0.0 && r[col("head_line.force")] >= 0.0);
+    }
+}

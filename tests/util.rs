@@ -62,3 +62,67 @@ pub fn parse_rao_csv(text: &str) -> Vec<RaoRow> {
         })
         .collect()
 }
+
+/// A fresh scratch directory under the system's temp dir, unique per test.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shipcast-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+/// A one-body WAMIT database with frequency-independent coefficients (rho = 1000, g = 9.81, L = 1):
+/// added mass `a` and damping `b` (6 diagonal values, SI), restoring diagonal `c`, and an excitation
+/// moment `roll_moment` N m per metre in roll for beam waves (heading 90 deg; -roll_moment at 270),
+/// zero elsewhere. Frequencies 0.05..3.0 rad/s. Writes `dir/flat.{1,3,hst}`.
+pub fn write_flat_database(dir: &Path, a: [f64; 6], b: [f64; 6], c: [f64; 6], roll_moment: f64) {
+    let (rho, g) = (1000.0, 9.81);
+    let k = |i: usize| if i < 3 { 3 } else { 5 };
+    let mut one = String::new();
+    one.push_str(&format!("{:e} {} {} {:e}\n", 0.0, 1, 1, a[0] / rho));
+    for i in 1..6 {
+        one.push_str(&format!("{:e} {} {} {:e}\n", 0.0, i + 1, i + 1, a[i] / rho));
+    }
+    let omegas: Vec<f64> = (1..=60).map(|s| 0.05 * s as f64).collect();
+    for w in &omegas {
+        let per = 2.0 * std::f64::consts::PI / w;
+        for i in 0..6 {
+            let scale = rho * 1f64.powi(k(i));
+            one.push_str(&format!(
+                "{per:e} {} {} {:e} {:e}\n",
+                i + 1,
+                i + 1,
+                a[i] / scale,
+                b[i] / (scale * w)
+            ));
+        }
+    }
+    std::fs::write(dir.join("flat.1"), one).unwrap();
+    let mut three = String::new();
+    for w in &omegas {
+        let per = 2.0 * std::f64::consts::PI / w;
+        for beta in [0.0, 90.0, 180.0, 270.0] {
+            for i in 0..6 {
+                let x = if i == 3 && beta == 90.0 {
+                    roll_moment
+                } else if i == 3 && beta == 270.0 {
+                    -roll_moment
+                } else {
+                    0.0
+                };
+                let xb = x / (rho * g);
+                let phase = if xb < 0.0 { 180.0 } else { 0.0 };
+                three.push_str(&format!("{per:e} {beta} {} {:e} {phase} {:e} 0\n", i + 1, xb.abs(), xb));
+            }
+        }
+    }
+    std::fs::write(dir.join("flat.3"), three).unwrap();
+    let mut hst = String::new();
+    for i in 0..6 {
+        for j in 0..6 {
+            let v = if i == j { c[i] / (rho * g) } else { 0.0 };
+            hst.push_str(&format!("{} {} {:e}\n", i + 1, j + 1, v));
+        }
+    }
+    std::fs::write(dir.join("flat.hst"), hst).unwrap();
+}

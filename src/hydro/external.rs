@@ -1095,4 +1095,105 @@ mod tests {
         assert!((t.c_t4 - 1000.0 * 9.81 * 2.0 * 4.0 * 100.0 / 2.0).abs() < 1e-6);
         assert!((t.b_tt - 0.2 * (t.a_tt * t.c_tt).sqrt()).abs() < 1e-6);
     }
+
+    fn two_bodies() -> External {
+        let conns = vec![
+            Connection {
+                name: "line".into(),
+                a: Anchor {
+                    body: Some(0),
+                    point_m: Vector3::new(40.0, 10.0, 3.0),
+                },
+                b: Anchor {
+                    body: Some(1),
+                    point_m: Vector3::new(30.0, -8.0, 3.0),
+                },
+                kind: ConnectionKind::MooringLine {
+                    curve: Curve::Polynomial(vec![1.0e6, 5.0e5]),
+                    unstretched_length_m: 19.5,
+                    damping_n_s_m: 1.0e4,
+                },
+            },
+            Connection {
+                name: "fender".into(),
+                a: Anchor {
+                    body: Some(0),
+                    point_m: Vector3::new(0.0, 12.0, 0.0),
+                },
+                b: Anchor {
+                    body: Some(1),
+                    point_m: Vector3::new(0.0, -8.0, 0.0),
+                },
+                kind: ConnectionKind::Fender {
+                    curve: Curve::Table(vec![(0.3, 2.0e5), (1.0, 1.5e6)]),
+                    normal: Vector3::new(0.0, -1.0, 0.0),
+                    initial_compression_m: 0.2,
+                    friction_coefficient: 0.0,
+                    friction_velocity_m_s: 0.01,
+                },
+            },
+        ];
+        External {
+            connections: conns,
+            body_positions_m: vec![Vector3::zeros(), Vector3::new(0.0, 30.0, 0.0)],
+            ..External::default()
+        }
+    }
+
+    fn small_state() -> impl proptest::strategy::Strategy<Value = Vec<f64>> {
+        use proptest::prelude::*;
+        proptest::collection::vec(-1.0f64..1.0, 12).prop_map(|v| {
+            v.iter()
+                .enumerate()
+                .map(|(i, x)| if i % 6 >= 3 { 0.02 * x } else { 2.0 * x })
+                .collect()
+        })
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn a_slack_line_carries_nothing_and_a_fender_never_pulls(x in small_state(), v in small_state()) {
+            let e = two_bodies();
+            let mut f = vec![];
+            e.connection_forces(&x, &v, &mut f);
+            proptest::prop_assert!(f[0] >= 0.0 && f[1] >= 0.0);
+            // line: zero when its length is below the unstretched length
+            let ConnectionKind::MooringLine { unstretched_length_m, .. } = &e.connections[0].kind else { unreachable!() };
+            let pa = e.rest_position(&e.connections[0].a) + e.anchor_motion(&e.connections[0].a, &x);
+            let pb = e.rest_position(&e.connections[0].b) + e.anchor_motion(&e.connections[0].b, &x);
+            if (pb - pa).norm() <= *unstretched_length_m {
+                proptest::prop_assert_eq!(f[0], 0.0);
+            }
+            // fender: the force on the carrier along the normal is a push (never toward the lighter)
+            let mut q = vec![0.0; 12];
+            e.nonlinear_force(&x, &v, &mut q);
+            let only_fender = External { connections: vec![e.connections[1].clone()], ..e.clone() };
+            let mut qf = vec![0.0; 12];
+            only_fender.nonlinear_force(&x, &v, &mut qf);
+            proptest::prop_assert!(qf[1] <= 0.0, "fender pulls the carrier toward the lighter: {}", qf[1]);
+            proptest::prop_assert!(qf[7] >= 0.0);
+        }
+
+        #[test]
+        fn connection_forces_are_minus_the_gradient_of_their_energy(x in small_state()) {
+            let e = two_bodies();
+            let zero = vec![0.0; 12];
+            let mut f = vec![0.0; 12];
+            e.nonlinear_force(&x, &zero, &mut f);
+            let mut f0 = vec![0.0; 12];
+            e.nonlinear_force(&zero, &zero, &mut f0);
+            for j in 0..12 {
+                let h = if j % 6 >= 3 { 1e-7 } else { 1e-5 };
+                let mut xp = x.clone();
+                xp[j] += h;
+                let mut xm = x.clone();
+                xm[j] -= h;
+                let grad = (e.potential_energy(&xp) - e.potential_energy(&xm)) / (2.0 * h);
+                // potential_energy removes the equilibrium force: F - F0 = -grad
+                let force = f[j] - f0[j];
+                let scale = f.iter().chain(&f0).fold(1.0f64, |m, v| m.max(v.abs())) * if j % 6 >= 3 { 50.0 } else { 1.0 };
+                proptest::prop_assert!((force + grad).abs() <= 1e-5 * scale, "mode {j}: force {force}, -grad {}", -grad);
+            }
+        }
+    }
 }
