@@ -1,4 +1,5 @@
 //! Helpers shared by the integration tests.
+#![allow(clippy::needless_range_loop)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
