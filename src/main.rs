@@ -290,6 +290,7 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
             ""
         }
     )?;
+    external_summary(&mut out, sys)?;
     let report = check::check(sys);
     writeln!(
         out,
@@ -496,6 +497,74 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
         let median = times_ms[times_ms.len() / 2];
         let p95 = times_ms[((times_ms.len() as f64 * 0.95).ceil() as usize).clamp(1, times_ms.len()) - 1];
         writeln!(out, "forecast_ms_median={median:.3} forecast_ms_p95={p95:.3}")?;
+    }
+    Ok(())
+}
+
+/// The system file's external models, as `db check` prints them.
+fn external_summary(out: &mut impl Write, sys: &shipcast::hydro::VesselSystem) -> Result<()> {
+    use shipcast::hydro::external::ConnectionKind;
+    let ext = &sys.spec.external;
+    let body = |b: Option<usize>| b.map(|k| sys.spec.bodies[k].name.clone()).unwrap_or_else(|| "earth".into());
+    if ext.connections.is_empty() && ext.tanks.is_empty() && ext.points.is_empty() {
+        return Ok(());
+    }
+    let n = sys.n_states();
+    let zero = vec![0.0; n];
+    let mut f = vec![];
+    ext.connection_forces(&zero, &zero, &mut f);
+    for (c, f0) in ext.connections.iter().zip(&f) {
+        let kind = match &c.kind {
+            ConnectionKind::SpringDamper { .. } => "spring-damper",
+            ConnectionKind::Bushing { .. } => "bushing",
+            ConnectionKind::MooringLine { .. } => "mooring line",
+            ConnectionKind::Fender { .. } => "fender",
+        };
+        writeln!(
+            out,
+            "connection {}: {kind}, {} -> {}, force at equilibrium {:.4e} N",
+            c.name,
+            body(c.a.body),
+            body(c.b.body),
+            f0
+        )?;
+    }
+    let mut net = vec![0.0; n];
+    ext.nonlinear_force(&zero, &zero, &mut net);
+    let worst = net.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if worst > 0.0 {
+        writeln!(
+            out,
+            "  lines and fenders at equilibrium: largest net generalized force {worst:.4e} (taken as balanced by the mean loads; the model works about it)"
+        )?;
+    }
+    for (t, name) in ext.tanks.iter().zip(&ext.tank_names) {
+        writeln!(
+            out,
+            "tank {name} on {}: fluid natural frequency {:.4} rad/s (T = {:.2} s), a_tt {:.4e}, b_tt {:.4e}, c_tt {:.4e}, a_t4 {:.4e}, c_t4 {:.4e}",
+            sys.spec.bodies[t.body].name,
+            t.natural_frequency_rad_s(),
+            2.0 * std::f64::consts::PI / t.natural_frequency_rad_s(),
+            t.a_tt,
+            t.b_tt,
+            t.c_tt,
+            t.a_t4,
+            t.c_t4
+        )?;
+    }
+    for p in &ext.points {
+        writeln!(
+            out,
+            "point {} on {} at ({:.3}, {:.3}, {:.3}) m",
+            p.name, sys.spec.bodies[p.body].name, p.point_m.x, p.point_m.y, p.point_m.z
+        )?;
+    }
+    for r in &ext.relative_motions {
+        writeln!(
+            out,
+            "relative motion {}: {} - {}",
+            r.name, ext.points[r.a].name, ext.points[r.b].name
+        )?;
     }
     Ok(())
 }
