@@ -505,7 +505,10 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
 fn external_summary(out: &mut impl Write, sys: &shipcast::hydro::VesselSystem) -> Result<()> {
     use shipcast::hydro::external::ConnectionKind;
     let ext = &sys.spec.external;
-    let body = |b: Option<usize>| b.map(|k| sys.spec.bodies[k].name.clone()).unwrap_or_else(|| "earth".into());
+    let body = |b: Option<usize>| {
+        b.map(|k| sys.spec.bodies[k].name.clone())
+            .unwrap_or_else(|| "earth".into())
+    };
     if ext.connections.is_empty() && ext.tanks.is_empty() && ext.points.is_empty() {
         return Ok(());
     }
