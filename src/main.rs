@@ -16,6 +16,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod cli;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "shipcast",
@@ -38,6 +40,8 @@ enum Command {
     Rao(RaoArgs),
     /// Forecast a scenario (system, sea, speed, history, horizon); with --repeat, time it.
     Forecast(ForecastArgs),
+    /// The predictable horizon of a radar disc in a sea state; last line `horizon_s=<x>`.
+    Horizon(cli::horizon::HorizonArgs),
 }
 
 #[derive(Args, Debug)]
@@ -185,6 +189,7 @@ fn main() -> ExitCode {
         } => db_check(&system, all_pairs),
         Command::Rao(args) => rao(&args),
         Command::Forecast(args) => forecast(&args),
+        Command::Horizon(args) => cli::horizon::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -435,6 +440,7 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
     let f = fc.forecast(&model, &req)?;
     let labels: Vec<String> = (0..sys.n_states()).map(|i| mode_label(sys, i)).collect();
     let extra = shipcast::rom::outputs::derived(&sys.spec.external, f);
+    let horizons = scenario_horizons(sys, &sc, &prep.waves);
     let mut text = String::new();
     match args.format {
         Format::Csv => {
@@ -468,9 +474,14 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
             let motion = series(f.n_modes, &|i| labels[i].clone(), &|k, i| f.at(k, i));
             let derived = series(extra.names.len(), &|c| extra.names[c].clone(), &|k, c| extra.at(k, c));
             text.push_str(&format!(
-                "{{\"dt_s\":{},\"horizon_s\":{},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{motion}}},\"points\":{{{derived}}}}}\n",
+                "{{\"dt_s\":{},\"horizon_s\":{},\"predictable_horizon_s\":{{{}}},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{motion}}},\"points\":{{{derived}}}}}\n",
                 f.dt_s,
                 f.steps as f64 * f.dt_s,
+                horizons
+                    .iter()
+                    .map(|(n, h)| format!("\"{n}\":{}", if h.is_finite() { format!("{h:.1}") } else { "null".into() }))
+                    .collect::<Vec<_>>()
+                    .join(","),
                 sc.opts.radiation,
                 f.skipped_components,
             ));
@@ -491,6 +502,18 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
         sc.horizon_s,
         sc.opts.dt_s,
         build_s
+    );
+    eprintln!(
+        "predictable horizon ({}): {}",
+        match sc.radar_radius_m {
+            Some(r) => format!("radar disc of {r} m around the origin"),
+            None => "the sea is known everywhere".into(),
+        },
+        horizons
+            .iter()
+            .map(|(n, h)| format!("{n} {h:.1} s"))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     if args.repeat > 1 {
         times_ms.sort_by(f64::total_cmp);
@@ -570,6 +593,50 @@ fn external_summary(out: &mut impl Write, sys: &shipcast::hydro::VesselSystem) -
         )?;
     }
     Ok(())
+}
+
+/// The predictable horizon of each vessel in a scenario: the sea at t0 seen over the scenario's radar
+/// disc around the origin (infinite without one), each vessel at its reference point.
+fn scenario_horizons(
+    sys: &shipcast::hydro::VesselSystem,
+    sc: &Scenario,
+    waves: &[shipcast::waves::WaveComponent],
+) -> Vec<(String, f64)> {
+    use shipcast::waves::field::{FieldComponent, Region, WaveField};
+    let field = WaveField {
+        components: waves
+            .iter()
+            .map(|c| FieldComponent {
+                omega_rad_s: c.omega_rad_s,
+                direction_rad: c.heading_rad,
+                amplitude_m: c.amplitude_m,
+            })
+            .collect(),
+        reference_m: [0.0, 0.0],
+        time_s: 0.0,
+        g_m_s2: sys.spec.g_m_s2,
+        depth_m: sys.spec.water_depth_m,
+        region: match sc.radar_radius_m {
+            Some(r) => Region::Disc {
+                centre_m: [0.0, 0.0],
+                radius_m: r,
+            },
+            None => Region::Everywhere,
+        },
+    };
+    sys.spec
+        .bodies
+        .iter()
+        .map(|b| {
+            let h = shipcast::waves::horizon::of_field(
+                &field,
+                [b.position_m.x, b.position_m.y],
+                [sc.opts.speed_m_s, 0.0],
+                0.0,
+            );
+            (b.name.clone(), h.horizon_s)
+        })
+        .collect()
 }
 
 fn rao(args: &RaoArgs) -> Result<()> {

@@ -21,6 +21,9 @@ struct ScenarioFile {
     #[serde(default)]
     speed_m_s: f64,
     radiation: Option<String>,
+    /// The radar's view: a disc of this radius around the origin at t0 (default: the sea is known
+    /// everywhere and the horizon is unlimited).
+    radar_radius_m: Option<f64>,
     sea: Option<SeaFile>,
     /// Explicit components instead of a sea state: amplitude and phase at the origin at the start of
     /// the history (t = -history_s).
@@ -94,6 +97,8 @@ pub struct Scenario {
     pub history_s: f64,
     pub opts: RomOptions,
     pub waves: Waves,
+    /// Radius of the observed disc around the origin, m (None: known everywhere).
+    pub radar_radius_m: Option<f64>,
 }
 
 impl Scenario {
@@ -116,6 +121,11 @@ impl Scenario {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(k, format!("must be positive, found {v}")));
             }
+        }
+        if let Some(r) = raw.radar_radius_m
+            && !(r.is_finite() && r > 0.0)
+        {
+            return Err(bad("radar_radius_m", format!("must be positive, found {r}")));
         }
         let radiation = match raw.radiation.as_deref() {
             None | Some("state-space") => RadiationMethod::StateSpace,
@@ -184,6 +194,7 @@ impl Scenario {
                 ..RomOptions::default()
             },
             waves,
+            radar_radius_m: raw.radar_radius_m,
         })
     }
 }

@@ -11,5 +11,6 @@ mod external_models;
 mod forecast_cli;
 mod kramers_kronig;
 mod rom;
+mod waves_fields;
 mod wecsim_rm3;
 mod wecsim_rm3_3dof;

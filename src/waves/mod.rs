@@ -1,5 +1,7 @@
-//! Phase-resolved wave fields (pure). For now: regular components and the dispersion relation; gridded
-//! and probe inputs, spectra and the predictable horizon come with the waves issue.
+//! Phase-resolved wave fields (pure): components in a vessel's frame ([`WaveComponent`]), the dispersion
+//! relation, earth-frame fields ([`field`]), measured inputs turned into fields ([`observe`]: radar
+//! grids, probe records), sea states and their realizations ([`sea`]), the predictable horizon
+//! ([`horizon`]).
 //!
 //! Conventions (DESIGN.md section 1): a component is eta(x, y, t) = Re{ a exp(i(w t - k (x cos b +
 //! y sin b))) } with a complex (m), w > 0 the absolute frequency (rad/s), b the direction the wave travels
@@ -78,4 +80,7 @@ mod tests {
     }
 }
 
+pub mod field;
+pub mod horizon;
+pub mod observe;
 pub mod sea;

@@ -1,0 +1,3 @@
+//! Subcommands of the `shipcast` binary that have grown past a few lines (shell: wiring only).
+
+pub mod horizon;

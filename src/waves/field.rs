@@ -1,0 +1,265 @@
+//! Phase-resolved wave fields in the earth frame (pure).
+//!
+//! Conventions (DESIGN.md section 1): earth frame x east, y north (local ENU tangent plane), m; a
+//! direction is where the waves travel to, counterclockwise from east, rad. A component is
+//! eta(p, t) = Re{ a exp(i(w (t - t_ref) - k d . (p - p_ref))) }, d = (cos dir, sin dir), k from the
+//! dispersion relation at the field's depth; `a` is the complex amplitude at the reference point at the
+//! reference time. A vessel's heading here is the direction of its +x axis, counterclockwise from east
+//! (compass headings are converted at the edges: [`heading_from_compass_deg`]).
+
+use super::{WaveComponent, wave_number};
+use num_complex::Complex64;
+
+/// Errors of wave-field inputs: the message names the field, cell or sample.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    #[error("{0}")]
+    Invalid(String),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// One directional component of a field (earth frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldComponent {
+    /// Absolute frequency, rad/s (> 0).
+    pub omega_rad_s: f64,
+    /// Direction of travel, counterclockwise from east, rad.
+    pub direction_rad: f64,
+    /// Complex amplitude at the field's reference point and time, m.
+    pub amplitude_m: Complex64,
+}
+
+/// Where a field was observed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Region {
+    /// Known everywhere (a synthetic sea, a list of components without a region).
+    Everywhere,
+    /// A disc (a radar's view), earth frame.
+    Disc { centre_m: [f64; 2], radius_m: f64 },
+    /// A point (a wave probe).
+    Point { at_m: [f64; 2] },
+}
+
+/// A phase-resolved wave field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WaveField {
+    pub components: Vec<FieldComponent>,
+    /// Reference point of the amplitudes, earth frame, m.
+    pub reference_m: [f64; 2],
+    /// Reference time of the amplitudes (the observation time), s on the sensors' clock.
+    pub time_s: f64,
+    pub g_m_s2: f64,
+    /// None = infinite depth.
+    pub depth_m: Option<f64>,
+    pub region: Region,
+}
+
+/// Converts a compass heading (clockwise from north, degrees) to a direction counterclockwise from
+/// east, radians.
+pub fn heading_from_compass_deg(compass_deg: f64) -> f64 {
+    (90.0 - compass_deg).to_radians()
+}
+
+impl WaveField {
+    /// Checks every component: positive finite frequency, finite direction and amplitude.
+    pub fn validate(&self) -> Result<()> {
+        for (i, c) in self.components.iter().enumerate() {
+            if !(c.omega_rad_s.is_finite() && c.omega_rad_s > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "component {i}: frequency {} rad/s must be positive and finite",
+                    c.omega_rad_s
+                )));
+            }
+            if !(c.direction_rad.is_finite() && c.amplitude_m.re.is_finite() && c.amplitude_m.im.is_finite()) {
+                return Err(Error::Invalid(format!(
+                    "component {i}: direction and amplitude must be finite"
+                )));
+            }
+        }
+        if !(self.g_m_s2.is_finite() && self.g_m_s2 > 0.0) {
+            return Err(Error::Invalid(format!("g = {}: must be positive", self.g_m_s2)));
+        }
+        if let Some(h) = self.depth_m
+            && !(h.is_finite() && h > 0.0)
+        {
+            return Err(Error::Invalid(format!("depth {h} m: must be positive")));
+        }
+        Ok(())
+    }
+
+    /// Refuses a field used `now_s` when it is older than `max_age_s` (or from the future).
+    pub fn check_age(&self, now_s: f64, max_age_s: f64) -> Result<()> {
+        let age = now_s - self.time_s;
+        if !(age.is_finite() && age <= max_age_s) {
+            return Err(Error::Invalid(format!(
+                "the wave field is {age:.1} s old (observed at {:.3} s, now {now_s:.3} s): beyond its validity of {max_age_s} s",
+                self.time_s
+            )));
+        }
+        if age < -1e-9 {
+            return Err(Error::Invalid(format!(
+                "the wave field is from the future: observed at {:.3} s, now {now_s:.3} s",
+                self.time_s
+            )));
+        }
+        Ok(())
+    }
+
+    /// Wave number of a component, rad/m.
+    pub fn wave_number(&self, omega_rad_s: f64) -> f64 {
+        wave_number(omega_rad_s, self.g_m_s2, self.depth_m)
+    }
+
+    /// Elevation at `points` (earth frame, m) at time `t_s`, into `out`.
+    pub fn elevation(&self, points: &[[f64; 2]], t_s: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|e| *e = 0.0);
+        let dt = t_s - self.time_s;
+        for c in &self.components {
+            let k = self.wave_number(c.omega_rad_s);
+            let (s, co) = c.direction_rad.sin_cos();
+            let (kx, ky) = (k * co, k * s);
+            let a0 = c.amplitude_m * Complex64::from_polar(1.0, c.omega_rad_s * dt);
+            for (p, e) in points.iter().zip(out.iter_mut()) {
+                let ph = kx * (p[0] - self.reference_m[0]) + ky * (p[1] - self.reference_m[1]);
+                let (sn, cs) = ph.sin_cos();
+                // Re{a0 exp(-i ph)}
+                *e += a0.re * cs + a0.im * sn;
+            }
+        }
+    }
+
+    /// Elevation at one point and time.
+    pub fn elevation_at(&self, p: [f64; 2], t_s: f64) -> f64 {
+        let mut e = [0.0];
+        self.elevation(&[p], t_s, &mut e);
+        e[0]
+    }
+
+    /// The field in a vessel's seakeeping frame at t0: each component's heading relative to the
+    /// vessel's +x and its amplitude at the vessel's origin (`position_m`, earth frame) at `t0_s`.
+    pub fn for_vessel(&self, position_m: [f64; 2], heading_rad: f64, t0_s: f64) -> Vec<WaveComponent> {
+        self.components
+            .iter()
+            .map(|c| {
+                let k = self.wave_number(c.omega_rad_s);
+                let (s, co) = c.direction_rad.sin_cos();
+                let ph = k * (co * (position_m[0] - self.reference_m[0]) + s * (position_m[1] - self.reference_m[1]));
+                WaveComponent {
+                    omega_rad_s: c.omega_rad_s,
+                    heading_rad: c.direction_rad - heading_rad,
+                    amplitude_m: c.amplitude_m * Complex64::from_polar(1.0, c.omega_rad_s * (t0_s - self.time_s) - ph),
+                }
+            })
+            .collect()
+    }
+
+    /// Variance sum |a|^2 / 2, m^2.
+    pub fn variance_m2(&self) -> f64 {
+        self.components.iter().map(|c| 0.5 * c.amplitude_m.norm_sqr()).sum()
+    }
+}
+
+/// Group velocity of frequency w at depth h (None: deep), m/s.
+pub fn group_velocity(omega_rad_s: f64, g_m_s2: f64, depth_m: Option<f64>) -> f64 {
+    let k = wave_number(omega_rad_s, g_m_s2, depth_m);
+    let c = omega_rad_s / k;
+    match depth_m {
+        Some(h) if k * h < 20.0 => {
+            let kh = k * h;
+            0.5 * c * (1.0 + 2.0 * kh / (2.0 * kh).sinh())
+        }
+        _ => 0.5 * c,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn field() -> WaveField {
+        WaveField {
+            components: vec![
+                FieldComponent {
+                    omega_rad_s: 0.6,
+                    direction_rad: 0.3,
+                    amplitude_m: Complex64::new(0.5, -0.2),
+                },
+                FieldComponent {
+                    omega_rad_s: 0.9,
+                    direction_rad: 2.0,
+                    amplitude_m: Complex64::new(-0.1, 0.3),
+                },
+            ],
+            reference_m: [100.0, -50.0],
+            time_s: 1000.0,
+            g_m_s2: 9.81,
+            depth_m: Some(60.0),
+            region: Region::Everywhere,
+        }
+    }
+
+    #[test]
+    fn elevation_is_the_analytic_sum() {
+        let f = field();
+        let p = [[350.0, 120.0], [-40.0, 10.0]];
+        let t = 1012.5;
+        let mut out = [0.0; 2];
+        f.elevation(&p, t, &mut out);
+        for (q, e) in p.iter().zip(out) {
+            let mut want = 0.0;
+            for c in &f.components {
+                let k = wave_number(c.omega_rad_s, 9.81, Some(60.0));
+                let ph = c.omega_rad_s * (t - 1000.0)
+                    - k * ((q[0] - 100.0) * c.direction_rad.cos() + (q[1] + 50.0) * c.direction_rad.sin());
+                want += (c.amplitude_m * Complex64::from_polar(1.0, ph)).re;
+            }
+            assert!((e - want).abs() < 1e-12, "{e} vs {want}");
+        }
+    }
+
+    #[test]
+    fn vessel_frame_gives_the_same_elevation_at_its_origin() {
+        let f = field();
+        let pos = [230.0, 75.0];
+        let comps = f.for_vessel(pos, 1.1, 1005.0);
+        // at the origin at t0 + 3 s: sum Re{a exp(i w 3)}
+        let e: f64 = comps
+            .iter()
+            .map(|c| (c.amplitude_m * Complex64::from_polar(1.0, c.omega_rad_s * 3.0)).re)
+            .sum();
+        assert!((e - f.elevation_at(pos, 1008.0)).abs() < 1e-12);
+        assert!((comps[0].heading_rad - (0.3 - 1.1)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn compass_conversion() {
+        assert!((heading_from_compass_deg(0.0) - PI / 2.0).abs() < 1e-15); // north
+        assert!(heading_from_compass_deg(90.0).abs() < 1e-15); // east
+        assert!((heading_from_compass_deg(270.0) + PI).abs() < 1e-12); // west
+    }
+
+    #[test]
+    fn group_velocity_limits() {
+        assert!((group_velocity(0.5, 9.81, None) - 9.81 / (2.0 * 0.5)).abs() < 1e-12);
+        // shallow: c_g -> sqrt(g h)
+        let cg = group_velocity(0.02, 9.81, Some(10.0));
+        assert!((cg - (98.1f64).sqrt()).abs() / cg < 1e-3);
+    }
+
+    #[test]
+    fn bad_components_are_named() {
+        let mut f = field();
+        f.components[1].omega_rad_s = 0.0;
+        assert!(f.validate().unwrap_err().to_string().contains("component 1"));
+        let mut f = field();
+        f.components[0].amplitude_m = Complex64::new(f64::NAN, 0.0);
+        assert!(f.validate().is_err());
+        let f = field();
+        assert!(f.check_age(1020.0, 30.0).is_ok());
+        let e = f.check_age(1042.0, 30.0).unwrap_err().to_string();
+        assert!(e.contains("42.0 s old") && e.contains("validity of 30 s"), "{e}");
+        assert!(f.check_age(990.0, 30.0).unwrap_err().to_string().contains("future"));
+    }
+}

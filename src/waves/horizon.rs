@@ -1,0 +1,220 @@
+//! The predictable horizon (pure): how far ahead the waves reaching a vessel were inside the observed
+//! region at the observation time.
+//!
+//! A wave group of frequency w travelling along d reaches the vessel (moving at velocity u from its
+//! position at t0) at lead time t only if it was inside the observed region at t0: at
+//! p0 + (u - c_g(w) d) t. Each part of the field thus has a lead time t_c after which it is unknown;
+//! the horizon is the lead time by which the unknown parts carry [`UNKNOWN_FRACTION`] of the variance
+//! (long waves, the fastest groups, go first), less the non-causal reach of the force RAO (the force at t
+//! depends on the waves up to that much later). For a disc of radius R around a stationary vessel and
+//! long-crested waves this is R / c_g,max, c_g,max the group velocity at the frequency below which that
+//! fraction of the energy lies.
+//!
+//! Frames: earth (x east, y north) for fields; for a sea state, directions relative to the vessel's +x,
+//! travel-to, counterclockwise (DESIGN.md section 1).
+
+use super::field::{Region, WaveField, group_velocity};
+use super::sea::jonswap;
+use std::f64::consts::PI;
+
+/// Variance share allowed to be unknown at the horizon.
+pub const UNKNOWN_FRACTION: f64 = 0.025;
+
+/// The horizon and how it came about.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Horizon {
+    /// Lead time up to which the force is predictable, s (infinite for a field known everywhere).
+    pub horizon_s: f64,
+    /// The waves' horizon before the non-causal reach is taken off, s.
+    pub wave_horizon_s: f64,
+    /// The frequency and direction (rad) of the limiting part, and its group velocity (m/s).
+    pub limiting_omega_rad_s: f64,
+    pub limiting_direction_rad: f64,
+    pub limiting_group_velocity_m_s: f64,
+    pub noncausal_s: f64,
+}
+
+/// Lead time at which a group leaves the observed disc: the largest t with
+/// |offset + (u - c_g d) t| <= R (0 if the vessel starts outside and the group never enters).
+fn disc_exit(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> f64 {
+    // |o + r t|^2 = R^2: (r.r) t^2 + 2 (o.r) t + (o.o - R^2) = 0
+    let a = rel[0] * rel[0] + rel[1] * rel[1];
+    let b = offset[0] * rel[0] + offset[1] * rel[1];
+    let c = offset[0] * offset[0] + offset[1] * offset[1] - radius * radius;
+    if a <= 0.0 {
+        return if c <= 0.0 { f64::INFINITY } else { 0.0 };
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return 0.0;
+    }
+    ((-b + disc.sqrt()) / a).max(0.0)
+}
+
+/// The horizon from (weight, lead time, omega, direction, c_g) of every part of the field.
+fn quantile(mut parts: Vec<(f64, f64, f64, f64, f64)>, noncausal_s: f64) -> Horizon {
+    parts.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let total: f64 = parts.iter().map(|p| p.0).sum();
+    let mut acc = 0.0;
+    let mut pick = parts.last().copied().unwrap_or((0.0, f64::INFINITY, 0.0, 0.0, 0.0));
+    for p in &parts {
+        acc += p.0;
+        if acc > UNKNOWN_FRACTION * total {
+            pick = *p;
+            break;
+        }
+    }
+    Horizon {
+        horizon_s: (pick.1 - noncausal_s).max(0.0),
+        wave_horizon_s: pick.1,
+        limiting_omega_rad_s: pick.2,
+        limiting_direction_rad: pick.3,
+        limiting_group_velocity_m_s: pick.4,
+        noncausal_s,
+    }
+}
+
+/// The horizon of an observed field for a vessel at `position_m` (earth) moving at `velocity_m_s`
+/// (earth) from the field's time on.
+pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2], noncausal_s: f64) -> Horizon {
+    let parts = field
+        .components
+        .iter()
+        .map(|c| {
+            let cg = group_velocity(c.omega_rad_s, field.g_m_s2, field.depth_m);
+            let d = [c.direction_rad.cos(), c.direction_rad.sin()];
+            let rel = [velocity_m_s[0] - cg * d[0], velocity_m_s[1] - cg * d[1]];
+            let t = match field.region {
+                Region::Everywhere => f64::INFINITY,
+                Region::Disc { centre_m, radius_m } => disc_exit(
+                    [position_m[0] - centre_m[0], position_m[1] - centre_m[1]],
+                    radius_m,
+                    rel,
+                ),
+                Region::Point { at_m } => {
+                    // a probe: the group reaches the (stationary) vessel after travelling from it
+                    let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
+                    let closing = cg - (velocity_m_s[0] * d[0] + velocity_m_s[1] * d[1]);
+                    if along > 0.0 && closing > 0.0 {
+                        along / closing
+                    } else {
+                        0.0
+                    }
+                }
+            };
+            (0.5 * c.amplitude_m.norm_sqr(), t, c.omega_rad_s, c.direction_rad, cg)
+        })
+        .collect();
+    quantile(parts, noncausal_s)
+}
+
+/// Directional spreading of a planning sea state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spreading {
+    LongCrested,
+    /// cos^2s((theta - theta0) / 2).
+    Cos2s(f64),
+    /// cos^2(theta - theta0) over |theta - theta0| < pi / 2.
+    Cos2,
+}
+
+/// A sea state for planning: JONSWAP (gamma = 1: Pierson-Moskowitz).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanningSea {
+    pub hs_m: f64,
+    pub tp_s: f64,
+    pub gamma: f64,
+    pub spreading: Spreading,
+    /// Mean direction the waves travel to, relative to the vessel's +x, rad (pi: head seas).
+    pub heading_rad: f64,
+}
+
+/// The horizon of a radar disc of `radius_m` centred on a vessel moving at `speed_m_s` along its +x,
+/// for a sea state (spectrum discretized finely in frequency and direction).
+pub fn of_sea(
+    sea: &PlanningSea,
+    radius_m: f64,
+    speed_m_s: f64,
+    g_m_s2: f64,
+    depth_m: Option<f64>,
+    noncausal_s: f64,
+) -> Horizon {
+    let wp = 2.0 * PI / sea.tp_s;
+    let nw = 2000;
+    let (w0, w1) = (0.2 * wp, 6.0 * wp);
+    let dw = (w1 - w0) / nw as f64;
+    let dirs: Vec<(f64, f64)> = match sea.spreading {
+        Spreading::LongCrested => vec![(0.0, 1.0)],
+        s => {
+            let nd = 360;
+            (0..nd)
+                .map(|j| {
+                    let d = -PI + (j as f64 + 0.5) * 2.0 * PI / nd as f64;
+                    let wgt = match s {
+                        Spreading::Cos2s(e) => (0.5 * d).cos().abs().powf(2.0 * e),
+                        Spreading::Cos2 if d.abs() < 0.5 * PI => d.cos().powi(2),
+                        _ => 0.0,
+                    };
+                    (d, wgt)
+                })
+                .filter(|(_, w)| *w > 0.0)
+                .collect()
+        }
+    };
+    let mut parts = Vec::with_capacity(nw * dirs.len());
+    for i in 0..nw {
+        let w = w0 + (i as f64 + 0.5) * dw;
+        let s = jonswap(sea.hs_m, sea.tp_s, sea.gamma, w) * dw;
+        let cg = group_velocity(w, g_m_s2, depth_m);
+        for (d, wd) in &dirs {
+            let dir = sea.heading_rad + d;
+            let rel = [speed_m_s - cg * dir.cos(), -cg * dir.sin()];
+            parts.push((s * wd, disc_exit([0.0, 0.0], radius_m, rel), w, dir, cg));
+        }
+    }
+    quantile(parts, noncausal_s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disc_exit_cases() {
+        // from the centre, moving at 5 m/s: R / 5
+        assert!((disc_exit([0.0, 0.0], 1000.0, [5.0, 0.0]) - 200.0).abs() < 1e-9);
+        // starting 600 m upstream (groups coming towards it from beyond the far edge)
+        assert!((disc_exit([600.0, 0.0], 1000.0, [5.0, 0.0]) - 80.0).abs() < 1e-9);
+        // outside and moving away: never inside
+        assert_eq!(disc_exit([2000.0, 0.0], 1000.0, [5.0, 0.0]), 0.0);
+    }
+
+    #[test]
+    fn head_speed_shortens_the_horizon() {
+        let sea = PlanningSea {
+            hs_m: 2.0,
+            tp_s: 10.0,
+            gamma: 3.3,
+            spreading: Spreading::LongCrested,
+            heading_rad: PI,
+        };
+        let still = of_sea(&sea, 2000.0, 0.0, 9.81, None, 0.0);
+        let head = of_sea(&sea, 2000.0, 5.0, 9.81, None, 0.0);
+        let short_crested = of_sea(
+            &PlanningSea {
+                spreading: Spreading::Cos2s(4.0),
+                ..sea
+            },
+            2000.0,
+            0.0,
+            9.81,
+            None,
+            0.0,
+        );
+        assert!(head.horizon_s < still.horizon_s);
+        // a disc is the same in every direction: spreading does not change a stationary vessel's horizon
+        assert!((short_crested.horizon_s - still.horizon_s).abs() < 0.01 * still.horizon_s);
+        let nc = of_sea(&sea, 2000.0, 0.0, 9.81, None, 12.0);
+        assert!((nc.horizon_s - (still.horizon_s - 12.0)).abs() < 1e-9);
+    }
+}

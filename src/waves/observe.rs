@@ -1,0 +1,435 @@
+//! Measured wave data turned into a [`WaveField`] (pure): gridded elevation snapshots (a wave radar
+//! processor's output) and a wave-probe record. Conventions as in [`super::field`].
+//!
+//! Grids: each snapshot is 2-D Fourier transformed; for every wavenumber bin k of one half-plane the
+//! frequency is fixed by the dispersion relation, w = w(|k|), so the bin's complex value over the
+//! snapshots is c(t) = P exp(+i w t) + Q exp(-i w t): P is a wave travelling along -k, Q one along +k.
+//! With two or more snapshots P and Q are fitted by least squares (a 3-D transform evaluated on the
+//! dispersion shell: energy off the shell, noise and the radar's artefacts, is rejected, and opposite
+//! travelling waves are told apart); with one snapshot the direction is taken from a mean-direction
+//! hint (the half-plane facing it). Bins outside the wavenumber band are left out.
+//!
+//! Probe: the record's FFT (the seed paper's method), long-crested along a given direction, amplitudes
+//! referred to the probe and the record's last sample.
+
+use super::field::{Error, FieldComponent, Region, Result, WaveField};
+use num_complex::Complex64;
+use rustfft::FftPlanner;
+use std::f64::consts::PI;
+
+/// One gridded elevation snapshot: `values[iy * x_m.len() + ix]` at (x_m[ix], y_m[iy]), earth frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    pub x_m: Vec<f64>,
+    pub y_m: Vec<f64>,
+    pub time_s: f64,
+    pub values: Vec<f64>,
+}
+
+/// Options of the grid inversion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridOptions {
+    pub g_m_s2: f64,
+    pub depth_m: Option<f64>,
+    /// Frequency band kept, rad/s.
+    pub omega_min_rad_s: f64,
+    pub omega_max_rad_s: f64,
+    /// Direction the waves travel to (earth frame), needed with a single snapshot.
+    pub mean_direction_rad: Option<f64>,
+    /// The radar's view: the field's region (default: the grid's inscribed disc).
+    pub region: Option<Region>,
+}
+
+fn uniform_spacing(v: &[f64], name: &str, snap: usize) -> Result<f64> {
+    if v.len() < 4 {
+        return Err(Error::Invalid(format!(
+            "snapshot {snap}: {name} has {} points: at least 4 are needed",
+            v.len()
+        )));
+    }
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(Error::Invalid(format!("snapshot {snap}: {name}[{i}] is not finite")));
+    }
+    let d = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
+    if d <= 0.0 {
+        return Err(Error::Invalid(format!("snapshot {snap}: {name} must increase")));
+    }
+    for i in 1..v.len() {
+        let step = v[i] - v[i - 1];
+        if (step - d).abs() > 1e-6 * d {
+            return Err(Error::Invalid(format!(
+                "snapshot {snap}: the grid is not uniform: {name}[{i}] - {name}[{}] = {step} m, the mean spacing is {d} m",
+                i - 1
+            )));
+        }
+    }
+    Ok(d)
+}
+
+/// Turns one or more snapshots of the same grid into a field referred to the grid's centre and the last
+/// snapshot's time.
+pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
+    let Some(first) = grids.first() else {
+        return Err(Error::Invalid("no grid snapshot given".into()));
+    };
+    if !(opts.omega_min_rad_s > 0.0 && opts.omega_max_rad_s > opts.omega_min_rad_s) {
+        return Err(Error::Invalid(format!(
+            "frequency band {}..{} rad/s: must be positive and increasing",
+            opts.omega_min_rad_s, opts.omega_max_rad_s
+        )));
+    }
+    let (nx, ny) = (first.x_m.len(), first.y_m.len());
+    let dx = uniform_spacing(&first.x_m, "x_m", 0)?;
+    let dy = uniform_spacing(&first.y_m, "y_m", 0)?;
+    for (s, g) in grids.iter().enumerate() {
+        if g.x_m != first.x_m || g.y_m != first.y_m {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: a different grid from snapshot 0"
+            )));
+        }
+        if g.values.len() != nx * ny {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: {} values for a {nx} x {ny} grid",
+                g.values.len()
+            )));
+        }
+        if let Some(i) = g.values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: cell (ix {}, iy {}) is not finite ({})",
+                i % nx,
+                i / nx,
+                g.values[i]
+            )));
+        }
+        if !g.time_s.is_finite() || (s > 0 && g.time_s <= grids[s - 1].time_s) {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: times must be finite and increasing"
+            )));
+        }
+    }
+    if grids.len() == 1 && opts.mean_direction_rad.is_none() {
+        return Err(Error::Invalid(
+            "a single snapshot cannot tell opposite directions apart: give the mean direction or a sequence".into(),
+        ));
+    }
+    let t_ref = grids[grids.len() - 1].time_s;
+    let n = (nx * ny) as f64;
+    // 2-D FFT of each snapshot (rows, then columns)
+    let mut planner = FftPlanner::new();
+    let fx = planner.plan_fft_forward(nx);
+    let fy = planner.plan_fft_forward(ny);
+    let spectra: Vec<Vec<Complex64>> = grids
+        .iter()
+        .map(|g| {
+            let mean = g.values.iter().sum::<f64>() / n;
+            let mut c: Vec<Complex64> = g.values.iter().map(|v| Complex64::new(v - mean, 0.0)).collect();
+            for row in c.chunks_exact_mut(nx) {
+                fx.process(row);
+            }
+            let mut col = vec![Complex64::default(); ny];
+            for ix in 0..nx {
+                for iy in 0..ny {
+                    col[iy] = c[iy * nx + ix];
+                }
+                fy.process(&mut col);
+                for iy in 0..ny {
+                    c[iy * nx + ix] = col[iy];
+                }
+            }
+            c
+        })
+        .collect();
+    let (lx, ly) = (dx * nx as f64, dy * ny as f64);
+    let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
+    let centre = [
+        0.5 * (first.x_m[0] + first.x_m[nx - 1]),
+        0.5 * (first.y_m[0] + first.y_m[ny - 1]),
+    ];
+    let origin = [first.x_m[0], first.y_m[0]];
+    let omega_of = |k: f64| match opts.depth_m {
+        Some(h) => (opts.g_m_s2 * k * (k * h).tanh()).sqrt(),
+        None => (opts.g_m_s2 * k).sqrt(),
+    };
+    let mut comps = vec![];
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let (mx, my) = (signed(ix, nx), signed(iy, ny));
+            // one half-plane; skip the mean and the Nyquist lines (their direction is ambiguous)
+            if (my < 0 || (my == 0 && mx <= 0)) || (nx % 2 == 0 && ix == nx / 2) || (ny % 2 == 0 && iy == ny / 2) {
+                continue;
+            }
+            let (kx, ky) = (2.0 * PI * mx as f64 / lx, 2.0 * PI * my as f64 / ly);
+            let k = kx.hypot(ky);
+            let w = omega_of(k);
+            if w < opts.omega_min_rad_s || w > opts.omega_max_rad_s {
+                continue;
+            }
+            let c: Vec<Complex64> = spectra.iter().map(|s| s[iy * nx + ix]).collect();
+            let (p, q) = if grids.len() == 1 {
+                let d = opts.mean_direction_rad.unwrap_or(0.0);
+                if kx * d.cos() + ky * d.sin() >= 0.0 {
+                    (Complex64::default(), c[0])
+                } else {
+                    (c[0], Complex64::default())
+                }
+            } else {
+                // least squares: c_j = P e_j + Q conj(e_j), e_j = exp(i w (t_j - t_ref))
+                let e: Vec<Complex64> = grids
+                    .iter()
+                    .map(|g| Complex64::from_polar(1.0, w * (g.time_s - t_ref)))
+                    .collect();
+                let (mut a11, mut a12) = (0.0, Complex64::default());
+                let (mut b1, mut b2) = (Complex64::default(), Complex64::default());
+                for (ej, cj) in e.iter().zip(&c) {
+                    a11 += 1.0;
+                    a12 += ej.conj() * ej.conj();
+                    b1 += ej.conj() * cj;
+                    b2 += ej * cj;
+                }
+                // [[a11, a12], [conj(a12), a11]] [P, Q] = [b1, b2]
+                let det = a11 * a11 - a12.norm_sqr();
+                if det <= 1e-9 * a11 * a11 {
+                    // the snapshots sample this frequency at the same phase: no separation possible
+                    continue;
+                }
+                ((b1 * a11 - a12 * b2) / det, (b2 * a11 - a12.conj() * b1) / det)
+            };
+            // amplitudes at the grid origin, then at the centre
+            for (coef, sign, conj) in [(p, -1.0, false), (q, 1.0, true)] {
+                if coef.norm() == 0.0 {
+                    continue;
+                }
+                let mut a = coef * (2.0 / n);
+                if conj {
+                    a = a.conj();
+                }
+                let (dxk, dyk) = (sign * kx, sign * ky);
+                let shift = dxk * (centre[0] - origin[0]) + dyk * (centre[1] - origin[1]);
+                comps.push(FieldComponent {
+                    omega_rad_s: w,
+                    direction_rad: dyk.atan2(dxk),
+                    amplitude_m: a * Complex64::from_polar(1.0, -shift),
+                });
+            }
+        }
+    }
+    let region = opts.region.unwrap_or(Region::Disc {
+        centre_m: centre,
+        radius_m: 0.5 * lx.min(ly),
+    });
+    let f = WaveField {
+        components: comps,
+        reference_m: centre,
+        time_s: t_ref,
+        g_m_s2: opts.g_m_s2,
+        depth_m: opts.depth_m,
+        region,
+    };
+    f.validate()?;
+    Ok(f)
+}
+
+/// A wave-probe record: `eta_m` sampled every `dt_s` up to `end_time_s` (the last sample), at
+/// `position_m`, waves travelling along `direction_rad` (long-crested); frequencies outside the band
+/// are left out.
+#[allow(clippy::too_many_arguments)]
+pub fn from_probe(
+    eta_m: &[f64],
+    dt_s: f64,
+    end_time_s: f64,
+    position_m: [f64; 2],
+    direction_rad: f64,
+    band_rad_s: (f64, f64),
+    g_m_s2: f64,
+    depth_m: Option<f64>,
+) -> Result<WaveField> {
+    if eta_m.len() < 8 {
+        return Err(Error::Invalid(format!(
+            "probe record has {} samples: at least 8 are needed",
+            eta_m.len()
+        )));
+    }
+    if !(dt_s.is_finite() && dt_s > 0.0) {
+        return Err(Error::Invalid(format!(
+            "probe sample interval {dt_s} s: must be positive"
+        )));
+    }
+    if let Some(i) = eta_m.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Invalid(format!("probe sample {i} is not finite ({})", eta_m[i])));
+    }
+    if !(band_rad_s.0 > 0.0 && band_rad_s.1 > band_rad_s.0) {
+        return Err(Error::Invalid(format!(
+            "frequency band {}..{} rad/s: must be positive and increasing",
+            band_rad_s.0, band_rad_s.1
+        )));
+    }
+    let n = eta_m.len();
+    let mean = eta_m.iter().sum::<f64>() / n as f64;
+    let mut c: Vec<Complex64> = eta_m.iter().map(|v| Complex64::new(v - mean, 0.0)).collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut c);
+    let span = n as f64 * dt_s;
+    let t_last_rel = (n - 1) as f64 * dt_s;
+    let mut comps = vec![];
+    for (m, cm) in c.iter().enumerate().take(n.div_ceil(2)).skip(1) {
+        let w = 2.0 * PI * m as f64 / span;
+        if w < band_rad_s.0 || w > band_rad_s.1 {
+            continue;
+        }
+        // eta_j = sum Re{a exp(i w j dt)}, a = 2 C_m / n; referred to the last sample
+        let a = cm * (2.0 / n as f64) * Complex64::from_polar(1.0, w * t_last_rel);
+        comps.push(FieldComponent {
+            omega_rad_s: w,
+            direction_rad,
+            amplitude_m: a,
+        });
+    }
+    let f = WaveField {
+        components: comps,
+        reference_m: position_m,
+        time_s: end_time_s,
+        g_m_s2,
+        depth_m,
+        region: Region::Point { at_m: position_m },
+    };
+    f.validate()?;
+    Ok(f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid_of(field: &WaveField, n: usize, d: f64, t: f64) -> Grid {
+        let x: Vec<f64> = (0..n).map(|i| -0.5 * d * n as f64 + d * i as f64).collect();
+        let mut pts = Vec::with_capacity(n * n);
+        for yy in &x {
+            for xx in &x {
+                pts.push([*xx, *yy]);
+            }
+        }
+        let mut v = vec![0.0; pts.len()];
+        field.elevation(&pts, t, &mut v);
+        Grid {
+            x_m: x.clone(),
+            y_m: x,
+            time_s: t,
+            values: v,
+        }
+    }
+
+    fn periodic_field(n: usize, d: f64) -> WaveField {
+        // components exactly on the grid's wavenumber lattice, travelling in opposite directions
+        let l = n as f64 * d;
+        let k1 = 2.0 * PI * 8.0 / l;
+        let k2 = 2.0 * PI * 11.0 / l;
+        WaveField {
+            components: vec![
+                FieldComponent {
+                    omega_rad_s: (9.81 * k1).sqrt(),
+                    direction_rad: 0.0,
+                    amplitude_m: Complex64::new(0.7, 0.2),
+                },
+                FieldComponent {
+                    omega_rad_s: (9.81 * k2).sqrt(),
+                    direction_rad: PI,
+                    amplitude_m: Complex64::new(-0.3, 0.4),
+                },
+            ],
+            reference_m: [0.0, 0.0],
+            time_s: 0.0,
+            g_m_s2: 9.81,
+            depth_m: None,
+            region: Region::Everywhere,
+        }
+    }
+
+    #[test]
+    fn a_sequence_separates_opposite_waves() {
+        let (n, d) = (64, 10.0);
+        let truth = periodic_field(n, d);
+        let grids: Vec<Grid> = [0.0, 1.5, 3.0].iter().map(|t| grid_of(&truth, n, d, *t)).collect();
+        let opts = GridOptions {
+            g_m_s2: 9.81,
+            depth_m: None,
+            omega_min_rad_s: 0.1,
+            omega_max_rad_s: 3.0,
+            mean_direction_rad: None,
+            region: None,
+        };
+        let f = from_grids(&grids, &opts).unwrap();
+        let big: Vec<&FieldComponent> = f.components.iter().filter(|c| c.amplitude_m.norm() > 0.01).collect();
+        assert_eq!(big.len(), 2, "{big:?}");
+        for want in &truth.components {
+            let got = big
+                .iter()
+                .find(|c| (c.omega_rad_s - want.omega_rad_s).abs() < 1e-9)
+                .expect("component found");
+            let dd = (got.direction_rad - want.direction_rad).rem_euclid(2.0 * PI);
+            assert!(
+                dd < 1e-9 || (2.0 * PI - dd) < 1e-9,
+                "direction {} vs {}",
+                got.direction_rad,
+                want.direction_rad
+            );
+            // amplitude at the field's reference (the grid centre) and the last snapshot's time
+            let k = want.omega_rad_s.powi(2) / 9.81;
+            let ph = k * (want.direction_rad.cos() * f.reference_m[0] + want.direction_rad.sin() * f.reference_m[1]);
+            let want_a = want.amplitude_m * Complex64::from_polar(1.0, want.omega_rad_s * 3.0 - ph);
+            assert!(
+                (got.amplitude_m - want_a).norm() < 1e-9,
+                "{} vs {want_a}",
+                got.amplitude_m
+            );
+        }
+    }
+
+    #[test]
+    fn bad_grids_are_refused_with_the_cell() {
+        let (n, d) = (16, 10.0);
+        let truth = periodic_field(n, d);
+        let opts = GridOptions {
+            g_m_s2: 9.81,
+            depth_m: None,
+            omega_min_rad_s: 0.1,
+            omega_max_rad_s: 3.0,
+            mean_direction_rad: Some(0.0),
+            region: None,
+        };
+        let mut g = grid_of(&truth, n, d, 0.0);
+        g.values[3 * n + 5] = f64::NAN;
+        let e = from_grids(std::slice::from_ref(&g), &opts).unwrap_err().to_string();
+        assert!(e.contains("cell (ix 5, iy 3) is not finite"), "{e}");
+        let mut g = grid_of(&truth, n, d, 0.0);
+        g.x_m[7] += 1.0;
+        let e = from_grids(&[g], &opts).unwrap_err().to_string();
+        assert!(e.contains("not uniform") && e.contains("x_m[7]"), "{e}");
+        let g = grid_of(&truth, n, d, 0.0);
+        let e = from_grids(&[g.clone(), g], &opts).unwrap_err().to_string();
+        assert!(e.contains("increasing"), "{e}");
+    }
+
+    #[test]
+    fn probe_record_reproduces_itself() {
+        let truth = periodic_field(64, 10.0);
+        let dt = 0.5;
+        let n = 512;
+        let p = [30.0, -20.0];
+        // a record that is periodic over its span: components on the FFT's frequency lattice
+        let span = n as f64 * dt;
+        let mut t = truth.clone();
+        for (c, m) in t.components.iter_mut().zip([20.0, 31.0]) {
+            c.omega_rad_s = 2.0 * PI * m / span;
+            c.direction_rad = 0.4;
+        }
+        let eta: Vec<f64> = (0..n).map(|j| t.elevation_at(p, j as f64 * dt)).collect();
+        let f = from_probe(&eta, dt, (n - 1) as f64 * dt, p, 0.4, (0.05, 3.0), 9.81, None).unwrap();
+        for j in [0, 100, n - 1] {
+            let tj = j as f64 * dt;
+            assert!((f.elevation_at(p, tj) - eta[j]).abs() < 1e-9);
+        }
+        // downstream: the same field
+        let q = [p[0] + 300.0 * 0.4f64.cos(), p[1] + 300.0 * 0.4f64.sin()];
+        let tq = 200.0;
+        assert!((f.elevation_at(q, tq) - t.elevation_at(q, tq)).abs() < 1e-9);
+    }
+}
