@@ -5,7 +5,7 @@
 use crate::files;
 use crate::rom::{self, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
 use crate::waves::WaveComponent;
-use crate::waves::sea::{self, SeaState};
+use crate::waves::sea::{self, SeaState, Spreading};
 use num_complex::Complex64;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -25,6 +25,8 @@ struct ScenarioFile {
     /// everywhere and the horizon is unlimited).
     radar_radius_m: Option<f64>,
     sea: Option<SeaFile>,
+    /// A second sea state superposed (swell); same keys as `[sea]`.
+    swell: Option<SeaFile>,
     /// Explicit components instead of a sea state: amplitude and phase at the origin at the start of
     /// the history (t = -history_s).
     #[serde(default)]
@@ -53,7 +55,10 @@ struct SeaFile {
     #[serde(default = "one")]
     gamma: f64,
     heading_deg: f64,
+    /// cos-2s spreading exponent (omit, and no `spreading`, for long-crested waves).
     spreading_s: Option<f64>,
+    /// "cos2" for cos^2 spreading instead.
+    spreading: Option<String>,
     components: usize,
     #[serde(default = "wmin")]
     omega_min_rad_s: f64,
@@ -85,7 +90,8 @@ pub enum Error {
 /// The waves of a scenario: a sea state to realize, or components as given.
 #[derive(Debug, Clone)]
 pub enum Waves {
-    Sea(SeaState),
+    /// One sea state, or several superposed (wind sea + swell).
+    Sea(Vec<SeaState>),
     Components(Vec<WaveComponent>),
 }
 
@@ -137,21 +143,39 @@ impl Scenario {
                 ));
             }
         };
+        let sea_of = |s: &SeaFile, key: &str| -> Result<SeaState, Error> {
+            let spreading = match (s.spreading.as_deref(), s.spreading_s) {
+                (None, None) => Spreading::LongCrested,
+                (None, Some(e)) => Spreading::Cos2s(e),
+                (Some("cos2"), None) => Spreading::Cos2,
+                (Some(o), _) => {
+                    return Err(bad(
+                        &format!("{key}.spreading"),
+                        format!("expected \"cos2\" (or spreading_s = <s> alone), found \"{o}\""),
+                    ));
+                }
+            };
+            let sea = SeaState {
+                hs_m: s.hs_m,
+                tp_s: s.tp_s,
+                gamma: s.gamma,
+                heading_rad: s.heading_deg.to_radians(),
+                spreading,
+                components: s.components,
+                omega_min_rad_s: s.omega_min_rad_s,
+                omega_max_rad_s: s.omega_max_rad_s,
+                seed: s.seed,
+            };
+            sea::validate(&sea).map_err(|m| bad(key, m))?;
+            Ok(sea)
+        };
         let waves = match (raw.sea, raw.component.is_empty()) {
             (Some(s), true) => {
-                let sea = SeaState {
-                    hs_m: s.hs_m,
-                    tp_s: s.tp_s,
-                    gamma: s.gamma,
-                    heading_rad: s.heading_deg.to_radians(),
-                    spreading_s: s.spreading_s,
-                    components: s.components,
-                    omega_min_rad_s: s.omega_min_rad_s,
-                    omega_max_rad_s: s.omega_max_rad_s,
-                    seed: s.seed,
-                };
-                sea::validate(&sea).map_err(|m| bad("sea", m))?;
-                Waves::Sea(sea)
+                let mut seas = vec![sea_of(&s, "sea")?];
+                if let Some(sw) = &raw.swell {
+                    seas.push(sea_of(sw, "swell")?);
+                }
+                Waves::Sea(seas)
             }
             (None, false) => {
                 let mut out = vec![];
@@ -225,7 +249,7 @@ impl Prepared {
 /// Runs the spin-up and returns the state, memory and waves at t0.
 pub fn prepare(model: &TimeModel, waves: &Waves, history_s: f64) -> rom::Result<Prepared> {
     let waves = match waves {
-        Waves::Sea(sea) => sea::realize(sea),
+        Waves::Sea(seas) => sea::realize_all(seas),
         Waves::Components(c) => c.clone(),
     };
     let n = model.n();

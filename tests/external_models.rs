@@ -333,7 +333,7 @@ fn two_ships_moored_together_stay_stable_in_beam_seas_for_30_minutes() {
         tp_s: 9.0,
         gamma: 3.3,
         heading_rad: PI / 2.0,
-        spreading_s: None,
+        spreading: shipcast::waves::sea::Spreading::LongCrested,
         components: 200,
         omega_min_rad_s: 0.3,
         omega_max_rad_s: 1.5,

@@ -27,7 +27,7 @@ fn sea(seed: u64, components: usize) -> SeaState {
         tp_s: 10.0,
         gamma: 3.3,
         heading_rad: 0.0,
-        spreading_s: None,
+        spreading: shipcast::waves::sea::Spreading::LongCrested,
         components,
         omega_min_rad_s: 0.3,
         omega_max_rad_s: 1.4,

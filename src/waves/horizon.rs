@@ -14,6 +14,7 @@
 //! travel-to, counterclockwise (DESIGN.md section 1).
 
 use super::field::{Region, WaveField, group_velocity};
+pub use super::sea::Spreading;
 use super::sea::jonswap;
 use std::f64::consts::PI;
 
@@ -108,16 +109,6 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
     quantile(parts, noncausal_s)
 }
 
-/// Directional spreading of a planning sea state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Spreading {
-    LongCrested,
-    /// cos^2s((theta - theta0) / 2).
-    Cos2s(f64),
-    /// cos^2(theta - theta0) over |theta - theta0| < pi / 2.
-    Cos2,
-}
-
 /// A sea state for planning: JONSWAP (gamma = 1: Pierson-Moskowitz).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanningSea {
@@ -150,12 +141,7 @@ pub fn of_sea(
             (0..nd)
                 .map(|j| {
                     let d = -PI + (j as f64 + 0.5) * 2.0 * PI / nd as f64;
-                    let wgt = match s {
-                        Spreading::Cos2s(e) => (0.5 * d).cos().abs().powf(2.0 * e),
-                        Spreading::Cos2 if d.abs() < 0.5 * PI => d.cos().powi(2),
-                        _ => 0.0,
-                    };
-                    (d, wgt)
+                    (d, s.weight(d))
                 })
                 .filter(|(_, w)| *w > 0.0)
                 .collect()

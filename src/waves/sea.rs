@@ -24,8 +24,8 @@ pub struct SeaState {
     pub gamma: f64,
     /// Mean direction the waves travel to, relative to the vessel's +x, rad.
     pub heading_rad: f64,
-    /// cos-2s spreading exponent; None = long-crested.
-    pub spreading_s: Option<f64>,
+    /// Directional spreading about the mean heading.
+    pub spreading: Spreading,
     /// Number of components.
     pub components: usize,
     /// Frequency band, rad/s.
@@ -33,6 +33,40 @@ pub struct SeaState {
     pub omega_max_rad_s: f64,
     /// Seed of the phases, frequencies and directions.
     pub seed: u64,
+}
+
+/// Directional spreading about a mean direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spreading {
+    LongCrested,
+    /// cos^2s((theta - theta0) / 2) over the circle.
+    Cos2s(f64),
+    /// cos^2(theta - theta0) over |theta - theta0| < pi / 2.
+    Cos2,
+}
+
+impl Spreading {
+    /// Unnormalized weight of a direction offset `d` (rad) from the mean.
+    pub fn weight(self, d: f64) -> f64 {
+        let d = (d + PI).rem_euclid(2.0 * PI) - PI;
+        match self {
+            Spreading::LongCrested => {
+                if d == 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            Spreading::Cos2s(s) => (0.5 * d).cos().abs().powf(2.0 * s),
+            Spreading::Cos2 => {
+                if d.abs() < 0.5 * PI {
+                    d.cos().powi(2)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
 }
 
 /// JONSWAP (gamma = 1: Pierson-Moskowitz) spectral density at w, m^2 s/rad.
@@ -72,13 +106,20 @@ pub fn validate(sea: &SeaState) -> Result<(), String> {
     if !sea.heading_rad.is_finite() {
         return Err("heading must be finite".into());
     }
-    if let Some(s) = sea.spreading_s {
+    if let Spreading::Cos2s(s) = sea.spreading {
         pos(s, "spreading_s")?;
     }
     Ok(())
 }
 
-/// A random-phase realization: amplitudes at the origin at t = 0.
+/// Several sea states superposed (swell + wind sea): their realizations concatenated.
+pub fn realize_all(seas: &[SeaState]) -> Vec<WaveComponent> {
+    seas.iter().flat_map(realize).collect()
+}
+
+/// A random-phase realization: amplitudes at the origin at t = 0. Frequencies are drawn at random
+/// within equal bins (no common period: a realization does not repeat), directions from the
+/// spreading function by rejection, phases uniform; all from `seed` (reproducible).
 pub fn realize(sea: &SeaState) -> Vec<WaveComponent> {
     let mut rng = ChaCha8Rng::seed_from_u64(sea.seed);
     let n = sea.components;
@@ -88,13 +129,13 @@ pub fn realize(sea: &SeaState) -> Vec<WaveComponent> {
             let w = sea.omega_min_rad_s + (k as f64 + rng.random::<f64>()) * dw;
             let amp = (2.0 * jonswap(sea.hs_m, sea.tp_s, sea.gamma, w) * dw).sqrt();
             let phase = 2.0 * PI * rng.random::<f64>();
-            let dir = match sea.spreading_s {
-                None => sea.heading_rad,
-                Some(s) => {
-                    // rejection sampling of cos^2s((b - b0) / 2) on (-pi, pi]
+            let dir = match sea.spreading {
+                Spreading::LongCrested => sea.heading_rad,
+                s => {
+                    // rejection sampling of the spreading function on (-pi, pi] (its peak weight is 1)
                     loop {
                         let d = PI * (2.0 * rng.random::<f64>() - 1.0);
-                        if rng.random::<f64>() <= (0.5 * d).cos().abs().powf(2.0 * s) {
+                        if rng.random::<f64>() <= s.weight(d) {
                             break sea.heading_rad + d;
                         }
                     }
@@ -130,7 +171,7 @@ mod tests {
             tp_s: 8.0,
             gamma: 3.3,
             heading_rad: PI,
-            spreading_s: Some(10.0),
+            spreading: Spreading::Cos2s(10.0),
             components: 2000,
             omega_min_rad_s: 0.2,
             omega_max_rad_s: 3.0,
@@ -140,5 +181,38 @@ mod tests {
         assert_eq!(a, realize(&sea));
         let var: f64 = a.iter().map(|c| 0.5 * c.amplitude_m.norm_sqr()).sum();
         assert!((var - 0.25).abs() < 0.02 * 0.25, "variance {var}");
+    }
+
+    #[test]
+    fn cos2_spreading_stays_within_90_degrees_and_swell_adds_up() {
+        let wind = SeaState {
+            hs_m: 2.0,
+            tp_s: 8.0,
+            gamma: 3.3,
+            heading_rad: 0.5,
+            spreading: Spreading::Cos2,
+            components: 500,
+            omega_min_rad_s: 0.2,
+            omega_max_rad_s: 3.0,
+            seed: 1,
+        };
+        let a = realize(&wind);
+        assert!(a.iter().all(|c| (c.heading_rad - 0.5).abs() < 0.5 * PI));
+        let swell = SeaState {
+            hs_m: 1.0,
+            tp_s: 14.0,
+            gamma: 1.0,
+            spreading: Spreading::LongCrested,
+            omega_min_rad_s: 0.2,
+            omega_max_rad_s: 1.0,
+            ..wind
+        };
+        let both = realize_all(&[wind, swell]);
+        assert_eq!(both.len(), 1000);
+        let var: f64 = both.iter().map(|c| 0.5 * c.amplitude_m.norm_sqr()).sum();
+        // m0 = (Hs1^2 + Hs2^2) / 16, within the finite bands
+        assert!((var - (4.0 + 1.0) / 16.0).abs() < 0.04 * var, "{var}");
+        assert_eq!(Spreading::Cos2.weight(0.6 * PI), 0.0);
+        assert!((Spreading::Cos2s(2.0).weight(0.0) - 1.0).abs() < 1e-15);
     }
 }
