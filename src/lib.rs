@@ -1,15 +1,19 @@
 //! shipcast: real-time motion forecasts for one or more ships, from a Cummins reduced-order model driven
 //! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
 //!
-//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`].
-//! Imperative shell: [`files`] (reading systems and databases from disk) and the `shipcast` binary.
+//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`].
+//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports),
+//! [`service`] (the daemon) and the `shipcast` binary.
 
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
 #![allow(clippy::needless_range_loop)]
 
 pub mod files;
 pub mod hydro;
+pub mod ipc;
 pub mod rao;
 pub mod rom;
 pub mod scenario;
+pub mod service;
+pub mod sim;
 pub mod waves;

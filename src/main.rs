@@ -42,6 +42,12 @@ enum Command {
     Forecast(ForecastArgs),
     /// The predictable horizon of a radar disc in a sea state; last line `horizon_s=<x>`.
     Horizon(cli::horizon::HorizonArgs),
+    /// The forecasting daemon: iceoryx2 in and out, a forecast every period.
+    Run(cli::daemon::RunArgs),
+    /// The synthetic sea: true motion and sensor streams (published live with --publish).
+    Simulate(cli::daemon::SimulateArgs),
+    /// Print forecasts and status as they arrive (the reference subscriber).
+    Watch(cli::daemon::WatchArgs),
 }
 
 #[derive(Args, Debug)]
@@ -177,19 +183,43 @@ impl Omegas {
     }
 }
 
+/// Logs to stderr: `RUST_LOG` if set, else `level`; human-readable or JSON lines.
+fn init_logging(level: &str, json: bool) {
+    // iceoryx2 logs through tracing; its warnings (e.g. "no config file, defaults used") are noise here
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| format!("{level},iceoryx2_bb_loggers=error").into());
+    let b = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    if json {
+        b.json().init();
+    } else {
+        b.init();
+    }
+}
+
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
-        .with_writer(std::io::stderr)
-        .init();
     let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Db {
-            command: DbCommand::Check { system, all_pairs },
-        } => db_check(&system, all_pairs),
-        Command::Rao(args) => rao(&args),
-        Command::Forecast(args) => forecast(&args),
-        Command::Horizon(args) => cli::horizon::run(&args),
+    let result = match &cli.command {
+        Command::Run(a) => match cli::daemon::load_config(&a.config) {
+            Ok(cfg) => {
+                init_logging(&cfg.log.level, cfg.log.format == "json");
+                Some(cli::daemon::run(cfg))
+            }
+            Err(e) => Some(Err(e)),
+        },
+        Command::Simulate(_) | Command::Watch(_) => {
+            init_logging("info", false);
+            None
+        }
+        _ => {
+            init_logging("warn", false);
+            None
+        }
+    };
+    let result = match result {
+        Some(r) => r,
+        None => dispatch(cli.command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -198,6 +228,20 @@ fn main() -> ExitCode {
             eprintln!("shipcast: error: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+fn dispatch(command: Command) -> Result<()> {
+    match command {
+        Command::Db {
+            command: DbCommand::Check { system, all_pairs },
+        } => db_check(&system, all_pairs),
+        Command::Rao(args) => rao(&args),
+        Command::Forecast(args) => forecast(&args),
+        Command::Horizon(args) => cli::horizon::run(&args),
+        Command::Run(_) => Ok(()),
+        Command::Simulate(args) => cli::daemon::simulate(&args),
+        Command::Watch(args) => cli::daemon::watch(&args),
     }
 }
 

@@ -7,6 +7,7 @@ mod util;
 mod bad_input;
 mod capytaine_demo;
 mod core_purity;
+mod daemon;
 mod external_models;
 mod forecast_cli;
 mod kramers_kronig;

@@ -1,3 +1,4 @@
 //! Subcommands of the `shipcast` binary that have grown past a few lines (shell: wiring only).
 
+pub mod daemon;
 pub mod horizon;

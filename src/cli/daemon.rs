@@ -1,0 +1,407 @@
+//! `shipcast run`, `simulate`, `watch` and `demo`: the daemon and its companions (wiring only).
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use shipcast::files;
+use shipcast::ipc::wire::{Status, flags};
+use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
+use shipcast::service::config::{self, ShipcastConfig};
+use shipcast::service::{self, to_wire, vessel_positions};
+use shipcast::sim::{ImuSpec, RadarSpec, SimSpec, Simulation};
+use shipcast::waves::field::heading_from_compass_deg;
+use shipcast::waves::sea::{SeaState, Spreading};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+pub const DEFAULT_CONFIG: &str = "config/shipcast.toml";
+
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Configuration file.
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    pub config: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Publish the sensor streams live over iceoryx2 (paced by the data clock / simulate.speed).
+    #[arg(long)]
+    publish: bool,
+    /// Write the true motion (t_s and every body DOF, at the IMU rate) to this CSV.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Simulated duration, s (default: simulate.duration_s).
+    #[arg(long)]
+    duration: Option<f64>,
+}
+
+#[derive(Args, Debug)]
+pub struct WatchArgs {
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Stop after N forecasts.
+    #[arg(long)]
+    count: Option<usize>,
+    /// One JSON object a line.
+    #[arg(long)]
+    json: bool,
+    /// Give up after this many seconds without a forecast (default: wait for ever).
+    #[arg(long)]
+    timeout: Option<f64>,
+}
+
+pub fn load_config(path: &Path) -> Result<ShipcastConfig> {
+    Ok(config::load(path)?)
+}
+
+fn system_path(cfg: &ShipcastConfig) -> PathBuf {
+    cfg.dir.join(&cfg.system.file)
+}
+
+pub fn run(cfg: ShipcastConfig) -> Result<()> {
+    let sys = files::load_system(&system_path(&cfg))?.system;
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()?;
+    let stop = Arc::new(AtomicBool::new(false));
+    rt.block_on(service::run(cfg, sys, stop))
+        .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
+    let s = &cfg.simulate;
+    SimSpec {
+        seas: vec![SeaState {
+            hs_m: s.sea.hs_m,
+            tp_s: s.sea.tp_s,
+            gamma: s.sea.gamma,
+            heading_rad: heading_from_compass_deg(s.sea.towards_deg),
+            spreading: match s.sea.spreading_s {
+                Some(e) => Spreading::Cos2s(e),
+                None => Spreading::LongCrested,
+            },
+            components: s.sea.components,
+            omega_min_rad_s: s.sea.omega_min_rad_s,
+            omega_max_rad_s: s.sea.omega_max_rad_s,
+            seed: s.seed,
+        }],
+        radar: RadarSpec {
+            radius_m: s.radar.radius_m,
+            cells: s.radar.cells,
+            period_s: s.radar.period_s,
+            noise_m: s.radar.noise_m,
+            snapshots: s.radar.snapshots,
+            omega_min_rad_s: 0.8 * s.sea.omega_min_rad_s,
+            omega_max_rad_s: 1.1 * s.sea.omega_max_rad_s,
+        },
+        imu: ImuSpec {
+            rate_hz: s.imu.rate_hz,
+            noise_m: s.imu.noise_m,
+            noise_rad: s.imu.noise_rad,
+            bias_m: s.imu.bias_m,
+            bias_rad: s.imu.bias_rad,
+        },
+        duration_s,
+        ramp_s: s.ramp_s,
+        heading_rad: heading_from_compass_deg(cfg.site.heading_deg),
+        origin_m: [cfg.site.origin_east_m, cfg.site.origin_north_m],
+        damping_factor: s.damping_factor,
+        seed: s.seed,
+    }
+}
+
+pub fn simulate(a: &SimulateArgs) -> Result<()> {
+    let cfg = load_config(&a.config)?;
+    let sys = files::load_system(&system_path(&cfg))?.system;
+    let duration = a.duration.unwrap_or(cfg.simulate.duration_s);
+    if !(duration.is_finite() && duration > 0.0) {
+        bail!("--duration {duration}: must be positive");
+    }
+    let t = Instant::now();
+    let mut sim = Simulation::new(&sys, service::rom_options(&cfg), sim_spec(&cfg, duration))
+        .context("computing the true motion")?;
+    tracing::info!(seconds = t.elapsed().as_secs_f64(), "true motion computed");
+    let n_bodies = sim.n_bodies;
+    let names: Vec<String> = sys
+        .spec
+        .bodies
+        .iter()
+        .flat_map(|b| ["surge", "sway", "heave", "roll", "pitch", "yaw"].map(|d| format!("{}.{d}", b.name)))
+        .collect();
+    let publisher = if a.publish {
+        Some(
+            SensorPublisher::new(&Names {
+                prefix: cfg.ipc.service_prefix.clone(),
+            })
+            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?,
+        )
+    } else {
+        None
+    };
+    // the data clock: UNIX seconds at the start, then simulation time
+    let epoch = service::wall_s();
+    let mut truth_out = match &a.truth {
+        Some(p) => {
+            let mut f =
+                std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?);
+            writeln!(f, "t_s,{}", names.join(","))?;
+            Some(f)
+        }
+        None => None,
+    };
+    let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
+    let radar_dt = cfg.simulate.radar.period_s;
+    let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
+    let start = Instant::now();
+    let speed = cfg.simulate.speed;
+    let mut stop_seen = false;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc_flag(stop);
+    }
+    while next_imu <= duration && !stop_seen {
+        let t = next_imu.min(next_radar);
+        if let Some(p) = &publisher {
+            let due = Duration::from_secs_f64(t / speed);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+            if next_radar <= next_imu {
+                if let Some(mut f) = sim.radar(t) {
+                    f.time_s += epoch;
+                    p.waves(&f).map_err(|e| anyhow::anyhow!("publishing waves: {e}"))?;
+                }
+                next_radar += radar_dt;
+                continue;
+            }
+            for mut s in sim.imu(t) {
+                s.time_s += epoch;
+                p.motion(&to_wire(&s))
+                    .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
+            }
+        } else if next_radar <= next_imu {
+            next_radar += radar_dt;
+            continue;
+        }
+        if let Some(f) = truth_out.as_mut() {
+            write!(f, "{:.3}", t + if publisher.is_some() { epoch } else { 0.0 })?;
+            for i in 0..6 * n_bodies {
+                write!(f, ",{:.6e}", sim.true_x(t, i))?;
+            }
+            writeln!(f)?;
+        }
+        next_imu += imu_dt;
+        stop_seen = stop.load(std::sync::atomic::Ordering::Relaxed);
+    }
+    if let Some(mut f) = truth_out {
+        f.flush()?;
+    }
+    Ok(())
+}
+
+/// Sets `flag` on SIGINT/SIGTERM (the simulator is not async).
+fn ctrlc_flag(flag: Arc<AtomicBool>) -> std::io::Result<()> {
+    std::thread::Builder::new().name("signals".into()).spawn(move || {
+        let Ok(rt) = tokio::runtime::Builder::new_current_thread().enable_all().build() else {
+            return;
+        };
+        rt.block_on(async {
+            let Ok(mut term) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) else {
+                return;
+            };
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {}
+                _ = term.recv() => {}
+            }
+        });
+        flag.store(true, std::sync::atomic::Ordering::Relaxed);
+    })?;
+    Ok(())
+}
+
+const DOF: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+
+/// A forecast as one JSON line (the format `watch --json` documents).
+pub fn forecast_json(
+    h: &shipcast::ipc::wire::ForecastHeader,
+    values: &[f64],
+    sys: &shipcast::hydro::VesselSystem,
+) -> String {
+    let n = h.steps as usize + 1;
+    let series = |s: usize| -> &[f64] { values.get(s * n..(s + 1) * n).unwrap_or(&[]) };
+    let num = |v: &f64| {
+        if v.is_finite() {
+            format!("{v:.5e}")
+        } else {
+            "null".into()
+        }
+    };
+    let ext = &sys.spec.external;
+    let vessels: Vec<String> = (0..h.n_vessels as usize)
+        .map(|b| {
+            let name = sys.spec.bodies.get(b).map(|x| x.name.as_str()).unwrap_or("?");
+            let dofs: Vec<String> = (0..6)
+                .map(|d| {
+                    let v: Vec<String> = series(6 * b + d).iter().map(num).collect();
+                    format!("\"{}\":[{}]", DOF[d], v.join(","))
+                })
+                .collect();
+            // points of interest on this vessel: displacement (x, y, z) over time
+            let points: Vec<String> = ext
+                .points
+                .iter()
+                .filter(|p| p.body == b)
+                .map(|p| {
+                    let mut comps = [vec![], vec![], vec![]];
+                    let mut x = vec![0.0; 6 * h.n_vessels as usize];
+                    for k in 0..n {
+                        for (i, xi) in x.iter_mut().enumerate() {
+                            *xi = series(i).get(k).copied().unwrap_or(0.0);
+                        }
+                        let m = ext.point_motion(p, &x);
+                        for c in 0..3 {
+                            comps[c].push(num(&m[c]));
+                        }
+                    }
+                    format!(
+                        "\"{}\":{{\"x\":[{}],\"y\":[{}],\"z\":[{}]}}",
+                        p.name,
+                        comps[0].join(","),
+                        comps[1].join(","),
+                        comps[2].join(",")
+                    )
+                })
+                .collect();
+            format!(
+                "{{\"name\":\"{name}\",\"horizon_s\":{:.1},\"dofs\":{{{}}},\"points\":{{{}}}}}",
+                h.horizon_s[b],
+                dofs.join(","),
+                points.join(",")
+            )
+        })
+        .collect();
+    let fl: Vec<String> = flags::names(h.flags).iter().map(|n| format!("\"{n}\"")).collect();
+    format!(
+        "{{\"kind\":\"forecast\",\"issue_time_s\":{:.3},\"dt_s\":{},\"wave_time_s\":{:.3},\"compute_ms\":{:.3},\"vessels\":[{}],\"flags\":[{}]}}",
+        h.issue_time_s,
+        h.dt_s,
+        h.wave_time_s,
+        h.compute_ms,
+        vessels.join(","),
+        fl.join(",")
+    )
+}
+
+pub fn status_json(s: &Status, n_vessels: usize) -> String {
+    let fl: Vec<String> = flags::names(s.flags).iter().map(|n| format!("\"{n}\"")).collect();
+    let list = |a: &[f64]| {
+        a[..n_vessels]
+            .iter()
+            .map(|v| format!("{v:.3}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    format!(
+        "{{\"kind\":\"status\",\"running\":{},\"time_s\":{:.3},\"wall_time_s\":{:.3},\"wave_age_s\":{:.3},\"motion_age_s\":[{}],\"motion_rate_hz\":[{}],\"last_forecast_time_s\":{:.3},\"last_compute_ms\":{:.3},\"horizon_s\":[{}],\"forecasts\":{},\"overruns\":{},\"samples\":{},\"wave_fields\":{},\"dropped_nonfinite\":{},\"dropped_late\":{},\"dropped_duplicate\":{},\"flags\":[{}]}}",
+        s.running == 1,
+        s.time_s,
+        s.wall_time_s,
+        s.wave_age_s,
+        list(&s.motion_age_s),
+        list(&s.motion_rate_hz),
+        s.last_forecast_time_s,
+        s.last_compute_ms,
+        list(&s.horizon_s),
+        s.forecasts,
+        s.overruns,
+        s.samples,
+        s.wave_fields,
+        s.dropped_nonfinite,
+        s.dropped_late,
+        s.dropped_duplicate,
+        fl.join(",")
+    )
+}
+
+pub fn watch(a: &WatchArgs) -> Result<()> {
+    let cfg = load_config(&a.config)?;
+    let sys = files::load_system(&system_path(&cfg))?.system;
+    let sub = ForecastSubscriber::new(&Names {
+        prefix: cfg.ipc.service_prefix.clone(),
+    })
+    .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+    let (_, _) = vessel_positions(&cfg, &sys);
+    let mut seen = 0usize;
+    let mut last_forecast = Instant::now();
+    let stop = Arc::new(AtomicBool::new(false));
+    ctrlc_flag(stop.clone())?;
+    let mut out = std::io::stdout().lock();
+    let mut got = vec![];
+    let n_vessels = sys.spec.bodies.len().min(shipcast::ipc::wire::MAX_VESSELS);
+    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+        got.clear();
+        sub.wait(Duration::from_millis(500), &mut got)
+            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+        for r in &got {
+            match r {
+                Received::Forecast(h, v) => {
+                    if h.schema_version != shipcast::ipc::wire::SCHEMA_VERSION {
+                        eprintln!("skipping a forecast of schema version {}", h.schema_version);
+                        continue;
+                    }
+                    seen += 1;
+                    last_forecast = Instant::now();
+                    if a.json {
+                        writeln!(out, "{}", forecast_json(h, v, &sys))?;
+                    } else {
+                        let n = h.steps as usize + 1;
+                        let mut line = format!(
+                            "forecast t0 {:.1} s, {:.0} s ahead, computed in {:.1} ms",
+                            h.issue_time_s,
+                            h.steps as f64 * h.dt_s,
+                            h.compute_ms
+                        );
+                        for b in 0..h.n_vessels as usize {
+                            let heave = &v[(6 * b + 2) * n..(6 * b + 3) * n];
+                            let peak = heave.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                            let name = sys.spec.bodies.get(b).map(|x| x.name.as_str()).unwrap_or("?");
+                            line.push_str(&format!(
+                                "; {name}: heave peak {peak:.2} m, horizon {:.0} s",
+                                h.horizon_s[b]
+                            ));
+                        }
+                        if h.flags != 0 {
+                            line.push_str(&format!(" [{}]", flags::names(h.flags).join(", ")));
+                        }
+                        writeln!(out, "{line}")?;
+                    }
+                    out.flush()?;
+                }
+                Received::Status(s) => {
+                    if a.json {
+                        writeln!(out, "{}", status_json(s, n_vessels))?;
+                    } else if s.running == 0 {
+                        writeln!(out, "shipcast stopped (last status)")?;
+                    }
+                    out.flush()?;
+                }
+            }
+        }
+        if a.count.is_some_and(|c| seen >= c) {
+            break;
+        }
+        if let Some(t) = a.timeout
+            && last_forecast.elapsed().as_secs_f64() > t
+        {
+            bail!("no forecast for {t} s");
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,466 @@
+//! iceoryx2 ports (shell): the service layout shared by every participant, the daemon's input and
+//! output threads bridged to tokio, and the small blocking endpoints the simulator and `watch` use.
+//!
+//! Ports live on threads of their own (iceoryx2 `ipc::Service` ports are not `Send`): the input thread
+//! sleeps in a WaitSet on the event services of `motion` and `waves` (woken by the publishers'
+//! notifications, plus a slow interval to notice shutdown) and forwards owned copies over a tokio
+//! channel; the output thread blocks on a std channel and publishes forecasts and status, notifying
+//! after each send. No busy polling. Signal handling is left to tokio (`SignalHandlingMode::Disabled`).
+
+pub mod wire;
+
+use crate::waves::field::{FieldComponent, Region, WaveField};
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use num_complex::Complex64;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+use wire::*;
+
+/// Subscriber buffers: a forecast cycle of 1 s at a 50 Hz IMU for 4 vessels fits.
+pub const BUFFER: usize = 256;
+/// How often blocked threads look at their stop flag.
+const STOP_CHECK: Duration = Duration::from_millis(200);
+
+pub type Error = Box<dyn std::error::Error + Send + Sync>;
+pub type Result<T> = std::result::Result<T, Error>;
+
+fn err(e: impl std::fmt::Display) -> Error {
+    e.to_string().into()
+}
+
+/// The service names of one deployment: `<prefix>/motion|waves|forecast|status`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Names {
+    pub prefix: String,
+}
+
+impl Names {
+    fn name(&self, kind: &str) -> Result<ServiceName> {
+        ServiceName::new(&format!("{}/{kind}", self.prefix)).map_err(err)
+    }
+}
+
+pub fn node() -> Result<Node<ipc::Service>> {
+    NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(err)
+}
+
+fn waitset() -> Result<WaitSet<ipc::Service>> {
+    WaitSetBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(err)
+}
+
+fn event(
+    node: &Node<ipc::Service>,
+    names: &Names,
+    kind: &str,
+) -> Result<(Notifier<ipc::Service>, Listener<ipc::Service>)> {
+    let svc = node
+        .service_builder(&names.name(kind)?)
+        .event()
+        .open_or_create()
+        .map_err(err)?;
+    Ok((
+        svc.notifier_builder().create().map_err(err)?,
+        svc.listener_builder().create().map_err(err)?,
+    ))
+}
+
+type SliceService<H> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [f64], H>;
+type FixedService<T> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
+
+fn motion_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<MotionSample>> {
+    node.service_builder(&names.name("motion")?)
+        .publish_subscribe::<MotionSample>()
+        .subscriber_max_buffer_size(BUFFER)
+        .max_publishers(8)
+        .open_or_create()
+        .map_err(err)
+}
+
+fn waves_service(node: &Node<ipc::Service>, names: &Names) -> Result<SliceService<WaveHeader>> {
+    node.service_builder(&names.name("waves")?)
+        .publish_subscribe::<[f64]>()
+        .user_header::<WaveHeader>()
+        .subscriber_max_buffer_size(8)
+        .history_size(1)
+        .open_or_create()
+        .map_err(err)
+}
+
+fn forecast_service(node: &Node<ipc::Service>, names: &Names) -> Result<SliceService<ForecastHeader>> {
+    node.service_builder(&names.name("forecast")?)
+        .publish_subscribe::<[f64]>()
+        .user_header::<ForecastHeader>()
+        .subscriber_max_buffer_size(8)
+        .history_size(1)
+        .open_or_create()
+        .map_err(err)
+}
+
+fn status_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<Status>> {
+    node.service_builder(&names.name("status")?)
+        .publish_subscribe::<Status>()
+        .subscriber_max_buffer_size(8)
+        .history_size(1)
+        .open_or_create()
+        .map_err(err)
+}
+
+/// A wave field decoded from the wire.
+pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<WaveField, String> {
+    if h.schema_version != SCHEMA_VERSION {
+        return Err(format!(
+            "wave field of schema version {} (this shipcast reads {SCHEMA_VERSION})",
+            h.schema_version
+        ));
+    }
+    if payload.len() != 4 * h.n_components as usize {
+        return Err(format!(
+            "wave field: {} values for {} components (4 each)",
+            payload.len(),
+            h.n_components
+        ));
+    }
+    let f = WaveField {
+        components: payload
+            .chunks_exact(4)
+            .map(|c| FieldComponent {
+                omega_rad_s: c[0],
+                direction_rad: c[1],
+                amplitude_m: Complex64::new(c[2], c[3]),
+            })
+            .collect(),
+        reference_m: [h.ref_east_m, h.ref_north_m],
+        time_s: h.time_s,
+        g_m_s2: h.g_m_s2,
+        depth_m: if h.depth_m > 0.0 { Some(h.depth_m) } else { None },
+        region: if h.radius_m > 0.0 {
+            Region::Disc {
+                centre_m: [h.ref_east_m, h.ref_north_m],
+                radius_m: h.radius_m,
+            }
+        } else {
+            Region::Everywhere
+        },
+    };
+    f.validate().map_err(|e| format!("wave field: {e}"))?;
+    Ok(f)
+}
+
+/// What the input thread forwards.
+#[derive(Debug, Clone)]
+pub enum Input {
+    Motion(MotionSample),
+    Waves(WaveField),
+    /// A sample that could not be decoded (counted, logged).
+    Rejected(String),
+}
+
+/// Spawns the daemon's input thread. It ends when `stop` is set or the channel closes.
+pub fn spawn_input(
+    names: Names,
+    tx: tokio::sync::mpsc::Sender<Input>,
+    stop: Arc<AtomicBool>,
+    ready: std::sync::mpsc::Sender<Result<()>>,
+) -> std::thread::JoinHandle<()> {
+    std::thread::Builder::new()
+        .name("shipcast-ipc-in".into())
+        .spawn(move || {
+            let setup = || -> Result<_> {
+                let node = node()?;
+                let motion = motion_service(&node, &names)?
+                    .subscriber_builder()
+                    .buffer_size(BUFFER)
+                    .create()
+                    .map_err(err)?;
+                let waves = waves_service(&node, &names)?
+                    .subscriber_builder()
+                    .create()
+                    .map_err(err)?;
+                let (_, motion_l) = event(&node, &names, "motion")?;
+                let (_, waves_l) = event(&node, &names, "waves")?;
+                Ok((node, motion, waves, motion_l, waves_l))
+            };
+            let (node, motion, waves, motion_l, waves_l) = match setup() {
+                Ok(s) => {
+                    let _ = ready.send(Ok(()));
+                    s
+                }
+                Err(e) => {
+                    let _ = ready.send(Err(e));
+                    return;
+                }
+            };
+            let _ = &node;
+            let ws = match waitset() {
+                Ok(w) => w,
+                Err(e) => {
+                    tracing::error!("input thread: waitset: {e}");
+                    return;
+                }
+            };
+            let (Ok(_g1), Ok(_g2), Ok(_g3)) = (
+                ws.attach_notification(&motion_l),
+                ws.attach_notification(&waves_l),
+                ws.attach_interval(STOP_CHECK),
+            ) else {
+                tracing::error!("input thread: cannot attach to the waitset");
+                return;
+            };
+            let drain = |motion: &Subscriber<ipc::Service, MotionSample, ()>,
+                         waves: &Subscriber<ipc::Service, [f64], WaveHeader>|
+             -> bool {
+                let _ = motion_l.try_wait(|_| {});
+                let _ = waves_l.try_wait(|_| {});
+                while let Ok(Some(s)) = motion.receive() {
+                    if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
+                        return false;
+                    }
+                }
+                while let Ok(Some(s)) = waves.receive() {
+                    let msg = match decode_waves(s.user_header(), s.payload()) {
+                        Ok(f) => Input::Waves(f),
+                        Err(e) => Input::Rejected(e),
+                    };
+                    if tx.blocking_send(msg).is_err() {
+                        return false;
+                    }
+                }
+                true
+            };
+            // whatever was there before we attached (history of the waves service)
+            if !drain(&motion, &waves) {
+                return;
+            }
+            loop {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let mut alive = true;
+                let r = ws.wait_and_process_once(|_| {
+                    alive = drain(&motion, &waves);
+                    CallbackProgression::Stop
+                });
+                if r.is_err() || !alive {
+                    break;
+                }
+            }
+        })
+        .expect("spawning the input thread")
+}
+
+/// What the output thread publishes.
+#[derive(Debug, Clone)]
+pub enum Output {
+    Forecast(ForecastHeader, Vec<f64>),
+    Status(Status),
+}
+
+/// Spawns the daemon's output thread; it ends when the channel closes (after publishing what is left).
+pub fn spawn_output(
+    names: Names,
+    rx: std::sync::mpsc::Receiver<Output>,
+    ready: std::sync::mpsc::Sender<Result<()>>,
+) -> std::thread::JoinHandle<()> {
+    std::thread::Builder::new()
+        .name("shipcast-ipc-out".into())
+        .spawn(move || {
+            let setup = || -> Result<_> {
+                let node = node()?;
+                let fc = forecast_service(&node, &names)?
+                    .publisher_builder()
+                    .initial_max_slice_len(6 * MAX_VESSELS * 6001)
+                    .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                    .create()
+                    .map_err(err)?;
+                let st = status_service(&node, &names)?
+                    .publisher_builder()
+                    .create()
+                    .map_err(err)?;
+                let (fc_n, _) = event(&node, &names, "forecast")?;
+                let (st_n, _) = event(&node, &names, "status")?;
+                Ok((node, fc, st, fc_n, st_n))
+            };
+            let (_node, fc, st, fc_n, st_n) = match setup() {
+                Ok(s) => {
+                    let _ = ready.send(Ok(()));
+                    s
+                }
+                Err(e) => {
+                    let _ = ready.send(Err(e));
+                    return;
+                }
+            };
+            while let Ok(out) = rx.recv() {
+                let r: Result<()> = (|| match out {
+                    Output::Forecast(h, values) => {
+                        let s = fc.loan_slice_uninit(values.len()).map_err(err)?;
+                        let mut s = s.write_from_slice(&values);
+                        *s.user_header_mut() = h;
+                        s.send().map_err(err)?;
+                        fc_n.notify().map_err(err)?;
+                        Ok(())
+                    }
+                    Output::Status(status) => {
+                        let s = st.loan_uninit().map_err(err)?;
+                        s.write_payload(status).send().map_err(err)?;
+                        st_n.notify().map_err(err)?;
+                        Ok(())
+                    }
+                })();
+                if let Err(e) = r {
+                    tracing::warn!("publishing failed: {e}");
+                }
+            }
+        })
+        .expect("spawning the output thread")
+}
+
+/// Publishers of a sensor suite (the simulator, or a bridge from real sensors): blocking.
+pub struct SensorPublisher {
+    _node: Node<ipc::Service>,
+    motion: Publisher<ipc::Service, MotionSample, ()>,
+    waves: Publisher<ipc::Service, [f64], WaveHeader>,
+    motion_n: Notifier<ipc::Service>,
+    waves_n: Notifier<ipc::Service>,
+}
+
+impl SensorPublisher {
+    pub fn new(names: &Names) -> Result<SensorPublisher> {
+        let node = node()?;
+        let motion = motion_service(&node, names)?
+            .publisher_builder()
+            .create()
+            .map_err(err)?;
+        let waves = waves_service(&node, names)?
+            .publisher_builder()
+            .initial_max_slice_len(4 * 4096)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(err)?;
+        let (motion_n, _) = event(&node, names, "motion")?;
+        let (waves_n, _) = event(&node, names, "waves")?;
+        Ok(SensorPublisher {
+            _node: node,
+            motion,
+            waves,
+            motion_n,
+            waves_n,
+        })
+    }
+
+    pub fn motion(&self, s: &MotionSample) -> Result<()> {
+        self.motion
+            .loan_uninit()
+            .map_err(err)?
+            .write_payload(*s)
+            .send()
+            .map_err(err)?;
+        self.motion_n.notify().map_err(err)?;
+        Ok(())
+    }
+
+    pub fn waves(&self, f: &WaveField) -> Result<()> {
+        let mut values = Vec::with_capacity(4 * f.components.len());
+        for c in &f.components {
+            values.extend([c.omega_rad_s, c.direction_rad, c.amplitude_m.re, c.amplitude_m.im]);
+        }
+        let radius_m = match f.region {
+            Region::Disc { radius_m, .. } => radius_m,
+            _ => 0.0,
+        };
+        let h = WaveHeader {
+            schema_version: SCHEMA_VERSION,
+            n_components: f.components.len() as u32,
+            time_s: f.time_s,
+            ref_east_m: f.reference_m[0],
+            ref_north_m: f.reference_m[1],
+            radius_m,
+            depth_m: f.depth_m.unwrap_or(0.0),
+            g_m_s2: f.g_m_s2,
+            reserved: 0.0,
+        };
+        let s = self.waves.loan_slice_uninit(values.len()).map_err(err)?;
+        let mut s = s.write_from_slice(&values);
+        *s.user_header_mut() = h;
+        s.send().map_err(err)?;
+        self.waves_n.notify().map_err(err)?;
+        Ok(())
+    }
+}
+
+/// What a forecast subscriber receives.
+#[derive(Debug, Clone)]
+pub enum Received {
+    Forecast(ForecastHeader, Vec<f64>),
+    Status(Status),
+}
+
+/// A blocking subscriber of forecasts and status (`shipcast watch`, consoles, tests).
+pub struct ForecastSubscriber {
+    _node: Node<ipc::Service>,
+    forecast: Subscriber<ipc::Service, [f64], ForecastHeader>,
+    status: Subscriber<ipc::Service, Status, ()>,
+    fc_l: Listener<ipc::Service>,
+    st_l: Listener<ipc::Service>,
+    ws: WaitSet<ipc::Service>,
+}
+
+impl ForecastSubscriber {
+    pub fn new(names: &Names) -> Result<ForecastSubscriber> {
+        let node = node()?;
+        let forecast = forecast_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let status = status_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let (_, fc_l) = event(&node, names, "forecast")?;
+        let (_, st_l) = event(&node, names, "status")?;
+        Ok(ForecastSubscriber {
+            _node: node,
+            forecast,
+            status,
+            fc_l,
+            st_l,
+            ws: waitset()?,
+        })
+    }
+
+    /// Everything received so far, without waiting.
+    pub fn drain(&self, out: &mut Vec<Received>) -> Result<()> {
+        let _ = self.fc_l.try_wait(|_| {});
+        let _ = self.st_l.try_wait(|_| {});
+        while let Some(s) = self.status.receive().map_err(err)? {
+            out.push(Received::Status(*s.payload()));
+        }
+        while let Some(s) = self.forecast.receive().map_err(err)? {
+            out.push(Received::Forecast(*s.user_header(), s.payload().to_vec()));
+        }
+        Ok(())
+    }
+
+    /// Waits up to `timeout` for the next notification, then drains.
+    pub fn wait(&self, timeout: Duration, out: &mut Vec<Received>) -> Result<()> {
+        let g1 = self.ws.attach_notification(&self.fc_l).map_err(err)?;
+        let g2 = self.ws.attach_notification(&self.st_l).map_err(err)?;
+        let _ = self
+            .ws
+            .wait_and_process_once_with_timeout(|_| CallbackProgression::Stop, timeout)
+            .map_err(err)?;
+        drop((g1, g2));
+        self.drain(out)
+    }
+}

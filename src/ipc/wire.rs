@@ -1,0 +1,170 @@
+//! The iceoryx2 wire types: what goes over shared memory, field by field (schema version 1).
+//!
+//! Every payload is `#[repr(C)]` with a stable type name, so a C, C++ or Python subscriber can declare
+//! the same layout (`tools/console/subscriber.py` does it with ctypes). Units SI; times are seconds on
+//! the sensors' clock (the data clock: UNIX seconds for live sensors); frames as in DESIGN.md section 1
+//! (earth: x east, y north; directions counterclockwise from east, travel-to; body: x forward, y port,
+//! z up; DOFs surge, sway, heave, roll, pitch, yaw). A reader checks `schema_version` first and refuses
+//! what it does not know.
+//!
+//! Services (names `<prefix>/<kind>`, each paired with an event service of the same name that is
+//! notified after every send):
+//! - `motion`: [`MotionSample`], one per IMU/navigation sample, any vessel.
+//! - `waves`: a slice of f64 with a [`WaveHeader`]: 4 values per component: omega (rad/s), direction
+//!   (rad, earth), Re and Im of the complex amplitude (m) at the header's reference point and time.
+//! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
+//!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad).
+//! - `status`: [`Status`].
+
+use iceoryx2::prelude::*;
+
+pub const SCHEMA_VERSION: u32 = 1;
+/// Vessels a forecast or status can describe.
+pub const MAX_VESSELS: usize = 4;
+
+/// Quality flags of forecasts and status (bits).
+pub mod flags {
+    /// The newest wave field is older than `max_wave_age_s`.
+    pub const STALE_WAVES: u32 = 1;
+    /// A vessel's newest motion sample is older than `max_motion_age_s`.
+    pub const STALE_MOTION: u32 = 2;
+    /// Less motion history than the radiation memory: the oldest part is taken as at rest.
+    pub const HISTORY_SHORT: u32 = 4;
+    /// The model diverged: no forecast this cycle.
+    pub const NUMERICAL: u32 = 8;
+    /// No wave field yet, or suppressed for age: no forecast.
+    pub const NO_WAVES: u32 = 16;
+    /// A gap in the motion history was bridged by interpolation.
+    pub const HISTORY_GAP: u32 = 32;
+    /// No motion for a vessel: no forecast.
+    pub const NO_MOTION: u32 = 64;
+
+    /// Names of the set bits.
+    pub fn names(f: u32) -> Vec<&'static str> {
+        [
+            (STALE_WAVES, "stale_waves"),
+            (STALE_MOTION, "stale_motion"),
+            (HISTORY_SHORT, "history_short"),
+            (NUMERICAL, "numerical_trouble"),
+            (NO_WAVES, "no_waves"),
+            (HISTORY_GAP, "history_gap"),
+            (NO_MOTION, "no_motion"),
+        ]
+        .iter()
+        .filter(|(b, _)| f & b != 0)
+        .map(|(_, n)| *n)
+        .collect()
+    }
+}
+
+/// One motion/navigation sample of one vessel. 112 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_MotionSample_v1")]
+#[repr(C)]
+pub struct MotionSample {
+    pub schema_version: u32,
+    /// Index of the vessel (its body in the system file, 0-based).
+    pub vessel: u32,
+    /// Sample time, s (data clock).
+    pub time_s: f64,
+    /// Displacement of surge..yaw about the mean position (m, rad), body frame.
+    pub x: [f64; 6],
+    /// Velocity (m/s, rad/s).
+    pub v: [f64; 6],
+}
+
+/// Header of a wave-field sample. 64 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_WaveHeader_v1")]
+#[repr(C)]
+pub struct WaveHeader {
+    pub schema_version: u32,
+    /// Number of components (4 f64 each in the payload).
+    pub n_components: u32,
+    /// Observation time the amplitudes refer to, s.
+    pub time_s: f64,
+    /// Reference point of the amplitudes, earth frame, m.
+    pub ref_east_m: f64,
+    pub ref_north_m: f64,
+    /// Radius of the observed disc around the reference point, m (0: unknown, treated as everywhere).
+    pub radius_m: f64,
+    /// Water depth, m (0: infinite).
+    pub depth_m: f64,
+    pub g_m_s2: f64,
+    pub reserved: f64,
+}
+
+/// Header of a forecast sample. 96 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_ForecastHeader_v1")]
+#[repr(C)]
+pub struct ForecastHeader {
+    pub schema_version: u32,
+    pub n_vessels: u32,
+    /// t0 of the forecast (the motion state it starts from), s.
+    pub issue_time_s: f64,
+    pub dt_s: f64,
+    /// Values per series: steps + 1.
+    pub steps: u32,
+    /// Number of series (6 per vessel).
+    pub n_series: u32,
+    /// [`flags`] bits.
+    pub flags: u32,
+    pub reserved: u32,
+    /// Time of the wave field used, s.
+    pub wave_time_s: f64,
+    /// Newest motion sample used, s.
+    pub motion_time_s: f64,
+    /// Wall-clock compute time of this forecast, ms.
+    pub compute_ms: f64,
+    /// Predictable horizon of each vessel, s (beyond it the forecast is not to be trusted).
+    pub horizon_s: [f64; MAX_VESSELS],
+}
+
+/// Health of the daemon, published every cycle. 208 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_Status_v1")]
+#[repr(C)]
+pub struct Status {
+    pub schema_version: u32,
+    /// [`flags`] bits of the current state.
+    pub flags: u32,
+    /// Newest data-clock time seen, s.
+    pub time_s: f64,
+    /// Wall-clock time of this status (UNIX s).
+    pub wall_time_s: f64,
+    /// Age of the newest wave field on the data clock, s (-1: none yet).
+    pub wave_age_s: f64,
+    /// Age of each vessel's newest motion sample, s (-1: none yet).
+    pub motion_age_s: [f64; MAX_VESSELS],
+    /// Measured sample rate of each vessel's motion stream, Hz.
+    pub motion_rate_hz: [f64; MAX_VESSELS],
+    /// Issue time of the last forecast published, s (-1: none).
+    pub last_forecast_time_s: f64,
+    pub last_compute_ms: f64,
+    pub horizon_s: [f64; MAX_VESSELS],
+    pub forecasts: u64,
+    /// Forecasts that ran past their period.
+    pub overruns: u64,
+    pub samples: u64,
+    pub wave_fields: u64,
+    pub dropped_nonfinite: u64,
+    pub dropped_late: u64,
+    pub dropped_duplicate: u64,
+    /// 1 while running, 0 in the last status before a clean shutdown.
+    pub running: u32,
+    pub reserved: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layouts_are_what_the_docs_say() {
+        assert_eq!(std::mem::size_of::<MotionSample>(), 112);
+        assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
+        assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
+        assert_eq!(std::mem::size_of::<Status>(), 208);
+    }
+}

@@ -1,0 +1,325 @@
+//! `config/shipcast.toml`: the daemon's, the simulator's and the watcher's configuration, read with the
+//! `config` crate (the TOML file, then `SHIPCAST_<SECTION>__<KEY>` environment variables over it) and
+//! validated with messages that name the key. Every key, its unit and default: `config/shipcast.toml`.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShipcastConfig {
+    #[serde(default)]
+    pub ipc: IpcConfig,
+    pub system: SystemConfig,
+    #[serde(default)]
+    pub site: SiteConfig,
+    #[serde(default)]
+    pub forecast: ForecastConfig,
+    #[serde(default)]
+    pub log: LogConfig,
+    #[serde(default)]
+    pub simulate: SimulateConfig,
+    /// Directory of the config file (relative paths are resolved against it); set by [`load`].
+    #[serde(skip)]
+    pub dir: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IpcConfig {
+    /// Service names are `<service_prefix>/motion|waves|forecast|status`.
+    pub service_prefix: String,
+}
+
+impl Default for IpcConfig {
+    fn default() -> Self {
+        IpcConfig {
+            service_prefix: "shipcast".into(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SystemConfig {
+    /// The vessels' system file, relative to the config file.
+    pub file: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SiteConfig {
+    /// Earth position (east, north) of the system's origin, m.
+    pub origin_east_m: f64,
+    pub origin_north_m: f64,
+    /// Compass heading of the system's +x axis (clockwise from north), deg.
+    pub heading_deg: f64,
+}
+
+impl Default for SiteConfig {
+    fn default() -> Self {
+        SiteConfig {
+            origin_east_m: 0.0,
+            origin_north_m: 0.0,
+            heading_deg: 90.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ForecastConfig {
+    /// A forecast every period, s.
+    pub period_s: f64,
+    /// Length of each forecast, s.
+    pub horizon_s: f64,
+    /// Solver step, s.
+    pub dt_s: f64,
+    /// "convolution" or "state-space".
+    pub radiation: String,
+    /// Radiation memory, s (default: the database's).
+    pub memory_s: Option<f64>,
+    /// A wave field older than this (data clock) is flagged stale, s.
+    pub max_wave_age_s: f64,
+    /// ... and beyond this no forecast is published (status only), s.
+    pub suppress_wave_age_s: f64,
+    /// No motion sample received for this long (wall clock): stale motion, no forecast, s.
+    pub max_motion_age_s: f64,
+    /// Gaps in the motion history up to this long are bridged linearly; a longer one ends the
+    /// history (what is before it counts as at rest), s.
+    pub max_gap_s: f64,
+    /// Motion samples kept per vessel beyond the radiation memory, s.
+    pub history_margin_s: f64,
+}
+
+impl Default for ForecastConfig {
+    fn default() -> Self {
+        ForecastConfig {
+            period_s: 1.0,
+            horizon_s: 120.0,
+            dt_s: 0.1,
+            radiation: "convolution".into(),
+            memory_s: None,
+            max_wave_age_s: 10.0,
+            suppress_wave_age_s: 30.0,
+            max_motion_age_s: 2.0,
+            max_gap_s: 1.0,
+            history_margin_s: 10.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LogConfig {
+    /// "human" or "json".
+    pub format: String,
+    /// Default filter when RUST_LOG is not set.
+    pub level: String,
+}
+
+impl Default for LogConfig {
+    fn default() -> Self {
+        LogConfig {
+            format: "human".into(),
+            level: "info".into(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimulateConfig {
+    pub duration_s: f64,
+    /// Data-clock seconds per wall-clock second.
+    pub speed: f64,
+    pub seed: u64,
+    /// Model error: the true linear damping is this factor times the model's.
+    pub damping_factor: f64,
+    pub ramp_s: f64,
+    pub sea: SeaConfig,
+    pub radar: RadarConfig,
+    pub imu: ImuConfig,
+}
+
+impl Default for SimulateConfig {
+    fn default() -> Self {
+        SimulateConfig {
+            duration_s: 3600.0,
+            speed: 1.0,
+            seed: 1,
+            damping_factor: 1.0,
+            ramp_s: 30.0,
+            sea: SeaConfig::default(),
+            radar: RadarConfig::default(),
+            imu: ImuConfig::default(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SeaConfig {
+    pub hs_m: f64,
+    pub tp_s: f64,
+    pub gamma: f64,
+    /// Compass direction the waves travel towards (clockwise from north), deg.
+    pub towards_deg: f64,
+    /// cos-2s spreading exponent; absent: long-crested.
+    pub spreading_s: Option<f64>,
+    pub components: usize,
+    pub omega_min_rad_s: f64,
+    pub omega_max_rad_s: f64,
+}
+
+impl Default for SeaConfig {
+    fn default() -> Self {
+        SeaConfig {
+            hs_m: 2.0,
+            tp_s: 9.0,
+            gamma: 3.3,
+            towards_deg: 270.0,
+            spreading_s: None,
+            components: 200,
+            omega_min_rad_s: 0.3,
+            omega_max_rad_s: 1.4,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RadarConfig {
+    pub radius_m: f64,
+    pub cells: usize,
+    pub period_s: f64,
+    pub noise_m: f64,
+    pub snapshots: usize,
+}
+
+impl Default for RadarConfig {
+    fn default() -> Self {
+        RadarConfig {
+            radius_m: 1000.0,
+            cells: 128,
+            period_s: 2.0,
+            noise_m: 0.05,
+            snapshots: 3,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ImuConfig {
+    pub rate_hz: f64,
+    pub noise_m: f64,
+    pub noise_rad: f64,
+    pub bias_m: f64,
+    pub bias_rad: f64,
+}
+
+impl Default for ImuConfig {
+    fn default() -> Self {
+        ImuConfig {
+            rate_hz: 10.0,
+            noise_m: 0.01,
+            noise_rad: 0.0005,
+            bias_m: 0.0,
+            bias_rad: 0.0,
+        }
+    }
+}
+
+/// A configuration error: the file or the key, and why.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("{file}: {msg}")]
+    Read { file: String, msg: String },
+    #[error("{file}: {key}: {msg}")]
+    Key { file: String, key: String, msg: String },
+}
+
+/// Reads the file, overlays `SHIPCAST_*` variables, validates.
+pub fn load(path: &Path) -> Result<ShipcastConfig, Error> {
+    let file = path.display().to_string();
+    let raw = config::Config::builder()
+        .add_source(config::File::from(path).format(config::FileFormat::Toml).required(true))
+        .add_source(
+            config::Environment::with_prefix("SHIPCAST")
+                .prefix_separator("_")
+                .separator("__")
+                .try_parsing(true),
+        )
+        .build()
+        .map_err(|e| Error::Read {
+            file: file.clone(),
+            msg: e.to_string(),
+        })?;
+    let mut cfg: ShipcastConfig = raw.try_deserialize().map_err(|e| Error::Read {
+        file: file.clone(),
+        msg: e.to_string(),
+    })?;
+    cfg.dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    validate(&cfg).map_err(|(key, msg)| Error::Key {
+        file: file.clone(),
+        key,
+        msg,
+    })?;
+    Ok(cfg)
+}
+
+fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
+    let pos = |k: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err((k.to_string(), format!("must be a positive number, found {v}")))
+        }
+    };
+    let f = &c.forecast;
+    pos("forecast.period_s", f.period_s)?;
+    pos("forecast.horizon_s", f.horizon_s)?;
+    pos("forecast.dt_s", f.dt_s)?;
+    pos("forecast.max_wave_age_s", f.max_wave_age_s)?;
+    pos("forecast.suppress_wave_age_s", f.suppress_wave_age_s)?;
+    pos("forecast.max_motion_age_s", f.max_motion_age_s)?;
+    pos("forecast.max_gap_s", f.max_gap_s)?;
+    if f.horizon_s > 3600.0 {
+        return Err((
+            "forecast.horizon_s".into(),
+            format!("at most 3600 s, found {}", f.horizon_s),
+        ));
+    }
+    if !["convolution", "state-space"].contains(&f.radiation.as_str()) {
+        return Err((
+            "forecast.radiation".into(),
+            format!("expected \"convolution\" or \"state-space\", found \"{}\"", f.radiation),
+        ));
+    }
+    if !["human", "json"].contains(&c.log.format.as_str()) {
+        return Err((
+            "log.format".into(),
+            format!("expected \"human\" or \"json\", found \"{}\"", c.log.format),
+        ));
+    }
+    if c.ipc.service_prefix.is_empty() || c.ipc.service_prefix.len() > 200 {
+        return Err(("ipc.service_prefix".into(), "must be 1..200 characters".into()));
+    }
+    let s = &c.simulate;
+    pos("simulate.duration_s", s.duration_s)?;
+    pos("simulate.speed", s.speed)?;
+    pos("simulate.damping_factor", s.damping_factor)?;
+    pos("simulate.sea.hs_m", s.sea.hs_m)?;
+    pos("simulate.sea.tp_s", s.sea.tp_s)?;
+    pos("simulate.radar.radius_m", s.radar.radius_m)?;
+    pos("simulate.radar.period_s", s.radar.period_s)?;
+    pos("simulate.imu.rate_hz", s.imu.rate_hz)?;
+    if !(8..=1024).contains(&s.radar.cells) {
+        return Err((
+            "simulate.radar.cells".into(),
+            format!("must be in 8..=1024, found {}", s.radar.cells),
+        ));
+    }
+    Ok(())
+}

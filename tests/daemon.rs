@@ -1,0 +1,246 @@
+//! The daemon end to end (issue 6): `shipcast simulate --publish` and `shipcast run` as separate
+//! processes over iceoryx2, forecasts received by `shipcast watch --json` and scored against the
+//! simulator's truth; fault cases. Each test uses its own service prefix, so they run in parallel.
+
+use crate::util::repo;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The issue's bar: heave and pitch correlation at 30 s lead.
+const MIN_CORRELATION: f64 = 0.9;
+const LEAD_S: f64 = 30.0;
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_shipcast")
+}
+
+/// A config for the one-ship demo with a unique prefix; `extra` is appended (TOML).
+fn config(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    let system = repo("config/vessels/ship/system.toml");
+    let text = format!(
+        r#"
+[ipc]
+service_prefix = "shipcast-test-{pid}-{name}"
+[system]
+file = "{system}"
+[site]
+heading_deg = 90.0
+[forecast]
+period_s = 0.5
+horizon_s = 60.0
+memory_s = 60.0
+max_motion_age_s = 2.0
+[log]
+level = "warn"
+[simulate]
+speed = 4.0
+seed = 3
+damping_factor = 1.2
+ramp_s = 20.0
+[simulate.sea]
+hs_m = 2.5
+tp_s = 9.0
+towards_deg = 270.0
+components = 150
+omega_max_rad_s = 1.3
+[simulate.radar]
+# 128 cells over 2 km: 15.6 m, waves down to 31 m (1.4 rad/s) without aliasing; the predictable
+# horizon (about 80 s) covers the 30 s lead
+radius_m = 1000.0
+cells = 128
+period_s = 2.0
+noise_m = 0.05
+{extra}
+"#,
+        pid = std::process::id(),
+        system = system.display()
+    );
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+struct Proc(Child);
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = Command::new("kill").args(["-INT", &self.0.id().to_string()]).status();
+        let t = Instant::now();
+        while t.elapsed() < Duration::from_secs(5) {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn spawn(args: &[&str]) -> Proc {
+    Proc(
+        Command::new(bin())
+            .args(args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("shipcast starts"),
+    )
+}
+
+/// Reads `watch --json` lines until `until` returns true or the time runs out.
+fn watch(cfg: &Path, secs: f64, mut until: impl FnMut(&serde_json::Value) -> bool) -> Vec<serde_json::Value> {
+    let mut child = Command::new(bin())
+        .args(["watch", "--json", "--config", cfg.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let mut out = vec![];
+    let t = Instant::now();
+    while t.elapsed().as_secs_f64() < secs {
+        if let Ok(line) = rx.recv_timeout(Duration::from_millis(200)) {
+            let v: serde_json::Value = serde_json::from_str(&line).expect("watch prints JSON");
+            let stop = until(&v);
+            out.push(v);
+            if stop {
+                break;
+            }
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    out
+}
+
+fn truth(path: &Path) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut t = vec![];
+    let mut rows = vec![];
+    for l in text.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        t.push(v[0]);
+        rows.push(v[1..].to_vec());
+    }
+    (t, rows)
+}
+
+fn at(t: &[f64], rows: &[Vec<f64>], time: f64, col: usize) -> Option<f64> {
+    let i = t.partition_point(|x| *x <= time);
+    if i == 0 || i >= t.len() {
+        return None;
+    }
+    let w = (time - t[i - 1]) / (t[i] - t[i - 1]);
+    Some(rows[i - 1][col] * (1.0 - w) + rows[i][col] * w)
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+#[test]
+fn forecasts_over_iceoryx2_match_the_simulated_truth() {
+    let dir = crate::util::scratch_dir("daemon-e2e");
+    let cfg = config(&dir, "e2e", "");
+    let truth_path = dir.join("truth.csv");
+    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let _sim = spawn(&[
+        "simulate",
+        "--publish",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration",
+        "240",
+        "--truth",
+        truth_path.to_str().unwrap(),
+    ]);
+    // 240 s of data at 4x: 60 s of wall time
+    let msgs = watch(&cfg, 75.0, |_| false);
+    let forecasts: Vec<&serde_json::Value> = msgs.iter().filter(|m| m["kind"] == "forecast").collect();
+    let statuses = msgs.iter().filter(|m| m["kind"] == "status").count();
+    assert!(forecasts.len() > 20, "{} forecasts, {statuses} status", forecasts.len());
+    std::thread::sleep(Duration::from_secs(2));
+    let (t, rows) = truth(&truth_path);
+    let t_start = t[0];
+    let (mut fh, mut th, mut fp, mut tp) = (vec![], vec![], vec![], vec![]);
+    for f in &forecasts {
+        let t0 = f["issue_time_s"].as_f64().unwrap();
+        // after the ramp and a full memory of history
+        if t0 - t_start < 80.0 {
+            continue;
+        }
+        let dt = f["dt_s"].as_f64().unwrap();
+        let k = (LEAD_S / dt).round() as usize;
+        let v = &f["vessels"][0]["dofs"];
+        let (Some(h), Some(p)) = (v["heave"][k].as_f64(), v["pitch"][k].as_f64()) else {
+            continue;
+        };
+        let (Some(h_true), Some(p_true)) = (at(&t, &rows, t0 + LEAD_S, 2), at(&t, &rows, t0 + LEAD_S, 4)) else {
+            continue;
+        };
+        fh.push(h);
+        th.push(h_true);
+        fp.push(p);
+        tp.push(p_true);
+    }
+    assert!(fh.len() >= 30, "only {} forecasts to score", fh.len());
+    let (ch, cp) = (correlation(&fh, &th), correlation(&fp, &tp));
+    eprintln!(
+        "{} forecasts, {} scored at {LEAD_S} s lead: heave correlation {ch:.3}, pitch {cp:.3}; horizon reported {} s",
+        forecasts.len(),
+        fh.len(),
+        forecasts.last().unwrap()["vessels"][0]["horizon_s"]
+    );
+    assert!(ch >= MIN_CORRELATION && cp >= MIN_CORRELATION);
+}
+
+#[test]
+fn a_config_with_a_wrong_key_or_type_is_refused() {
+    let dir = crate::util::scratch_dir("daemon-badcfg");
+    let cfg = config(&dir, "bad1", "[forecast2]\nperiod_s = 1.0\n");
+    let out = Command::new(bin())
+        .args(["run", "--config", cfg.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("forecast2"), "{err}");
+    let cfg = config(&dir, "bad2", "").to_str().unwrap().to_string();
+    let text = std::fs::read_to_string(&cfg)
+        .unwrap()
+        .replace("period_s = 0.5", "period_s = \"fast\"");
+    std::fs::write(&cfg, text).unwrap();
+    let out = Command::new(bin()).args(["run", "--config", &cfg]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("period_s"), "{err}");
+    // a bad value through the environment names the key too
+    let cfg = config(&dir, "bad3", "");
+    let out = Command::new(bin())
+        .args(["run", "--config", cfg.to_str().unwrap()])
+        .env("SHIPCAST_FORECAST__DT_S", "-1")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("forecast.dt_s"), "{err}");
+}
