@@ -5,7 +5,15 @@ use crate::util::repo;
 use std::path::{Path, PathBuf};
 
 /// The core: the database, frequency-domain solver, and (as they arrive) waves, ROM and scoring.
-const CORE: &[&str] = &["src/hydro", "src/rao.rs", "src/waves", "src/rom", "src/skill", "src/sim.rs", "src/service/history.rs"];
+const CORE: &[&str] = &[
+    "src/hydro",
+    "src/rao.rs",
+    "src/waves",
+    "src/rom",
+    "src/skill",
+    "src/sim.rs",
+    "src/service/history.rs",
+];
 const FORBIDDEN: &[&str] = &[
     "tokio",
     "iceoryx2",

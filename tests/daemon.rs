@@ -244,3 +244,167 @@ fn a_config_with_a_wrong_key_or_type_is_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("forecast.dt_s"), "{err}");
 }
+
+fn status_of(r: &shipcast::ipc::Received) -> Option<shipcast::ipc::wire::Status> {
+    match r {
+        shipcast::ipc::Received::Status(s) => Some(*s),
+        _ => None,
+    }
+}
+
+#[test]
+fn faults_are_counted_flagged_and_survived() {
+    use shipcast::ipc::wire::{MotionSample, SCHEMA_VERSION, flags};
+    use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
+    use shipcast::waves::field::{FieldComponent, Region, WaveField};
+    let dir = crate::util::scratch_dir("daemon-faults");
+    let cfg = config(&dir, "faults", "");
+    // faster cadence and short ages for the test
+    let text = std::fs::read_to_string(&cfg).unwrap().replace(
+        "period_s = 0.5\n",
+        "period_s = 0.25\nmax_wave_age_s = 1.5\nsuppress_wave_age_s = 3.0\n",
+    );
+    std::fs::write(&cfg, text).unwrap();
+    let prefix = format!("shipcast-test-{}-faults", std::process::id());
+    let names = Names { prefix: prefix.clone() };
+    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let sub = ForecastSubscriber::new(&names).unwrap();
+    let field = |t: f64| WaveField {
+        components: vec![FieldComponent {
+            omega_rad_s: 0.6,
+            direction_rad: std::f64::consts::PI,
+            amplitude_m: num_complex::Complex64::new(1.0, 0.0),
+        }],
+        reference_m: [0.0, 0.0],
+        time_s: t,
+        g_m_s2: 9.81,
+        depth_m: None,
+        region: Region::Disc {
+            centre_m: [0.0, 0.0],
+            radius_m: 1000.0,
+        },
+    };
+    let sample = |t: f64, v: f64| MotionSample {
+        schema_version: SCHEMA_VERSION,
+        vessel: 0,
+        time_s: t,
+        x: [0.0, 0.0, v, 0.0, 0.0, 0.0],
+        v: [0.0; 6],
+    };
+    let t_start = shipcast::service::wall_s();
+    let mut got = vec![];
+    let run_for = |p: &SensorPublisher, secs: f64, waves: bool, got: &mut Vec<Received>| {
+        let t = Instant::now();
+        let mut k = 0;
+        while t.elapsed().as_secs_f64() < secs {
+            let now = shipcast::service::wall_s();
+            p.motion(&sample(now, 0.1)).unwrap();
+            if waves && k % 10 == 0 {
+                p.waves(&field(now)).unwrap();
+            }
+            k += 1;
+            std::thread::sleep(Duration::from_millis(100));
+            sub.drain(got).unwrap();
+        }
+    };
+    {
+        let p = SensorPublisher::new(&names).unwrap();
+        run_for(&p, 3.0, true, &mut got);
+        // bad samples: NaN, duplicate, out of order
+        let now = shipcast::service::wall_s();
+        p.motion(&sample(now, f64::NAN)).unwrap();
+        p.motion(&sample(now, 0.1)).unwrap();
+        p.motion(&sample(now, 0.1)).unwrap();
+        p.motion(&sample(now - 5.0, 0.1)).unwrap();
+        run_for(&p, 1.0, true, &mut got);
+        let forecasts_before = got.iter().filter(|r| matches!(r, Received::Forecast(..))).count();
+        assert!(forecasts_before > 5, "{forecasts_before} forecasts");
+        let s = got.iter().filter_map(status_of).last().unwrap();
+        eprintln!(
+            "dropped: {} non-finite, {} late, {} duplicate",
+            s.dropped_nonfinite, s.dropped_late, s.dropped_duplicate
+        );
+        assert!(s.dropped_nonfinite >= 1 && s.dropped_late >= 1 && s.dropped_duplicate >= 1);
+        // the radar stops: stale, then suppressed
+        got.clear();
+        run_for(&p, 5.0, false, &mut got);
+        let stale = got
+            .iter()
+            .any(|r| matches!(r, Received::Forecast(h, _) if h.flags & flags::STALE_WAVES != 0));
+        let last_status = got.iter().filter_map(status_of).last().unwrap();
+        let tail_forecasts = got
+            .iter()
+            .rev()
+            .take_while(|r| !matches!(r, Received::Forecast(..)))
+            .filter(|r| matches!(r, Received::Status(..)))
+            .count();
+        eprintln!(
+            "radar stopped: stale forecasts seen {stale}; last status flags {:?}, {tail_forecasts} status since the last forecast",
+            flags::names(last_status.flags)
+        );
+        assert!(stale);
+        assert!(last_status.flags & flags::NO_WAVES != 0);
+        assert!(
+            tail_forecasts >= 4,
+            "forecasts still published after the suppression age"
+        );
+    } // the publisher goes away (its process would have died)
+    std::thread::sleep(Duration::from_millis(2800));
+    got.clear();
+    sub.drain(&mut got).unwrap();
+    let s = got.iter().filter_map(status_of).last().unwrap();
+    assert!(s.flags & flags::STALE_MOTION != 0, "{:?}", flags::names(s.flags));
+    // a new publisher: the daemon resumes
+    let p = SensorPublisher::new(&names).unwrap();
+    got.clear();
+    run_for(&p, 3.0, true, &mut got);
+    let resumed = got
+        .iter()
+        .filter(|r| matches!(r, Received::Forecast(h, _) if h.issue_time_s > t_start + 12.0))
+        .count();
+    eprintln!("after the restart: {resumed} forecasts");
+    assert!(resumed >= 3);
+}
+
+#[test]
+fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
+    use shipcast::ipc::{ForecastSubscriber, Names, Received};
+    let dir = crate::util::scratch_dir("daemon-kill");
+    let cfg = config(&dir, "kill", "");
+    let names = Names {
+        prefix: format!("shipcast-test-{}-kill", std::process::id()),
+    };
+    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let sub = ForecastSubscriber::new(&names).unwrap();
+    let sim_args = [
+        "simulate",
+        "--publish",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration",
+        "200",
+    ];
+    let mut sim = spawn(&sim_args);
+    let mut got = vec![];
+    let count = |got: &Vec<Received>| got.iter().filter(|r| matches!(r, Received::Forecast(..))).count();
+    let t = Instant::now();
+    while t.elapsed() < Duration::from_secs(6) {
+        sub.wait(Duration::from_millis(300), &mut got).unwrap();
+    }
+    let before = count(&got);
+    // SIGKILL: no clean-up at all
+    let _ = sim.0.kill();
+    let _ = sim.0.wait();
+    std::thread::sleep(Duration::from_secs(3));
+    let _sim2 = spawn(&sim_args);
+    got.clear();
+    let t = Instant::now();
+    while t.elapsed() < Duration::from_secs(8) {
+        sub.wait(Duration::from_millis(300), &mut got).unwrap();
+    }
+    let after = count(&got);
+    eprintln!("forecasts: {before} before the kill, {after} after the restart");
+    assert!(before >= 3 && after >= 3);
+}
