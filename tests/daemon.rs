@@ -320,7 +320,7 @@ fn faults_are_counted_flagged_and_survived() {
         run_for(&p, 1.0, true, &mut got);
         let forecasts_before = got.iter().filter(|r| matches!(r, Received::Forecast(..))).count();
         assert!(forecasts_before > 5, "{forecasts_before} forecasts");
-        let s = got.iter().filter_map(status_of).last().unwrap();
+        let s = got.iter().rev().find_map(status_of).unwrap();
         eprintln!(
             "dropped: {} non-finite, {} late, {} duplicate",
             s.dropped_nonfinite, s.dropped_late, s.dropped_duplicate
@@ -332,7 +332,7 @@ fn faults_are_counted_flagged_and_survived() {
         let stale = got
             .iter()
             .any(|r| matches!(r, Received::Forecast(h, _) if h.flags & flags::STALE_WAVES != 0));
-        let last_status = got.iter().filter_map(status_of).last().unwrap();
+        let last_status = got.iter().rev().find_map(status_of).unwrap();
         let tail_forecasts = got
             .iter()
             .rev()
@@ -353,7 +353,7 @@ fn faults_are_counted_flagged_and_survived() {
     std::thread::sleep(Duration::from_millis(2800));
     got.clear();
     sub.drain(&mut got).unwrap();
-    let s = got.iter().filter_map(status_of).last().unwrap();
+    let s = got.iter().rev().find_map(status_of).unwrap();
     assert!(s.flags & flags::STALE_MOTION != 0, "{:?}", flags::names(s.flags));
     // a new publisher: the daemon resumes
     let p = SensorPublisher::new(&names).unwrap();
