@@ -408,3 +408,48 @@ fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
     eprintln!("forecasts: {before} before the kill, {after} after the restart");
     assert!(before >= 3 && after >= 3);
 }
+
+#[test]
+fn a_python_console_decodes_a_live_forecast() {
+    let have = Command::new("python3").args(["-c", "import iceoryx2"]).status();
+    assert!(
+        have.is_ok_and(|s| s.success()),
+        "python3 with the iceoryx2 package is needed: python3 -m pip install -r tools/console/requirements.txt"
+    );
+    let dir = crate::util::scratch_dir("daemon-python");
+    let cfg = config(&dir, "python", "");
+    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let _sim = spawn(&[
+        "simulate",
+        "--publish",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration",
+        "100",
+    ]);
+    let out = Command::new("python3")
+        .args([
+            repo("tools/console/subscriber.py").to_str().unwrap(),
+            "--prefix",
+            &format!("shipcast-test-{}-python", std::process::id()),
+            "--count",
+            "2",
+            "--timeout",
+            "30",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 2);
+    for l in &lines {
+        assert_eq!(l["dt_s"], 0.1);
+        assert_eq!(l["steps"], 600);
+        let h = l["vessels"][0]["heave_at_lead_s"]["30"].as_f64().unwrap();
+        assert!(h.is_finite() && h.abs() < 10.0);
+        assert!(l["vessels"][0]["horizon_s"].as_f64().unwrap() > 30.0);
+    }
+    eprintln!("python decoded: {}", lines[0]);
+}

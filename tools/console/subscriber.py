@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""A shipcast forecast subscriber in Python: the reference for console writers in other languages.
+
+Reads the daemon's `<prefix>/forecast` service over iceoryx2 (pip package `iceoryx2`, the same version
+as the crate: see requirements.txt) and decodes the payload documented in src/ipc/wire.rs:
+a ForecastHeader user header and a slice of f64, series-major, series s = 6 v + d (vessel v, DOF d in
+surge, sway, heave, roll, pitch, yaw), steps + 1 displacements each at issue_time_s + k dt_s.
+
+    python3 tools/console/subscriber.py --prefix shipcast --count 3
+
+Prints one JSON object per forecast: issue time, dt, horizon per vessel, flags, and the heave of each
+vessel at 0, 30 and 60 s ahead. Exits non-zero if nothing arrives within --timeout seconds.
+"""
+
+import argparse
+import ctypes
+import json
+import sys
+import time
+
+import iceoryx2 as iox2
+
+SCHEMA_VERSION = 1
+MAX_VESSELS = 4
+DOFS = ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+FLAGS = ["stale_waves", "stale_motion", "history_short", "numerical_trouble", "no_waves", "history_gap", "no_motion"]
+
+
+class ForecastHeader(ctypes.Structure):
+    """shipcast_ForecastHeader_v1 (96 bytes)."""
+
+    _fields_ = [
+        ("schema_version", ctypes.c_uint32),
+        ("n_vessels", ctypes.c_uint32),
+        ("issue_time_s", ctypes.c_double),
+        ("dt_s", ctypes.c_double),
+        ("steps", ctypes.c_uint32),
+        ("n_series", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("wave_time_s", ctypes.c_double),
+        ("motion_time_s", ctypes.c_double),
+        ("compute_ms", ctypes.c_double),
+        ("horizon_s", ctypes.c_double * MAX_VESSELS),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "shipcast_ForecastHeader_v1"
+
+
+def decode(header, payload) -> dict:
+    if header.schema_version != SCHEMA_VERSION:
+        raise ValueError(f"schema version {header.schema_version}: this script reads {SCHEMA_VERSION}")
+    n = header.steps + 1
+    expected = header.n_series * n
+    count = payload.len()
+    # iceoryx2 0.10's Python binding reports the length of a Rust `[f64]` slice in bytes: accept both
+    if count not in (expected, 8 * expected):
+        raise ValueError(f"{count} values for {header.n_series} series of {n}")
+    values = list((ctypes.c_double * expected).from_address(payload.as_ptr()))
+    vessels = []
+    for v in range(header.n_vessels):
+        heave = values[(6 * v + 2) * n:(6 * v + 3) * n]
+        at = {}
+        for lead in (0.0, 30.0, 60.0):
+            k = int(round(lead / header.dt_s))
+            if k < n:
+                at[f"{lead:.0f}"] = heave[k]
+        vessels.append({"horizon_s": header.horizon_s[v], "heave_at_lead_s": at})
+    return {
+        "issue_time_s": header.issue_time_s,
+        "dt_s": header.dt_s,
+        "steps": header.steps,
+        "compute_ms": header.compute_ms,
+        "flags": [f for i, f in enumerate(FLAGS) if header.flags & (1 << i)],
+        "vessels": vessels,
+    }
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--prefix", default="shipcast")
+    ap.add_argument("--count", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=30.0)
+    a = ap.parse_args()
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
+    node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+    service = (
+        node.service_builder(iox2.ServiceName.new(f"{a.prefix}/forecast"))
+        .publish_subscribe(iox2.Slice[ctypes.c_double])
+        .user_header(ForecastHeader)
+        .open()
+    )
+    subscriber = service.subscriber_builder().create()
+    seen = 0
+    t0 = time.monotonic()
+    while seen < a.count:
+        if time.monotonic() - t0 > a.timeout:
+            print(f"no forecast within {a.timeout} s", file=sys.stderr)
+            return 1
+        sample = subscriber.receive()
+        if sample is None:
+            time.sleep(0.05)
+            continue
+        print(json.dumps(decode(sample.user_header().contents, sample.payload())), flush=True)
+        seen += 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
