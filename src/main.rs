@@ -48,6 +48,8 @@ enum Command {
     Simulate(cli::daemon::SimulateArgs),
     /// Print forecasts and status as they arrive (the reference subscriber).
     Watch(cli::daemon::WatchArgs),
+    /// One command to try it: the synthetic sea, the daemon and a live view of forecasts and skill.
+    Demo(cli::daemon::DemoArgs),
 }
 
 #[derive(Args, Debug)]
@@ -208,7 +210,7 @@ fn main() -> ExitCode {
             }
             Err(e) => Some(Err(e)),
         },
-        Command::Simulate(_) | Command::Watch(_) => {
+        Command::Simulate(_) | Command::Watch(_) | Command::Demo(_) => {
             init_logging("info", false);
             None
         }
@@ -242,6 +244,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Run(_) => Ok(()),
         Command::Simulate(args) => cli::daemon::simulate(&args),
         Command::Watch(args) => cli::daemon::watch(&args),
+        Command::Demo(args) => cli::daemon::demo(&args),
     }
 }
 

@@ -289,11 +289,12 @@ pub fn forecast_json(
         .collect();
     let fl: Vec<String> = flags::names(h.flags).iter().map(|n| format!("\"{n}\"")).collect();
     format!(
-        "{{\"kind\":\"forecast\",\"issue_time_s\":{:.3},\"dt_s\":{},\"wave_time_s\":{:.3},\"compute_ms\":{:.3},\"vessels\":[{}],\"flags\":[{}]}}",
+        "{{\"kind\":\"forecast\",\"issue_time_s\":{:.3},\"dt_s\":{},\"wave_time_s\":{:.3},\"compute_ms\":{:.3},\"received_wall_s\":{:.3},\"vessels\":[{}],\"flags\":[{}]}}",
         h.issue_time_s,
         h.dt_s,
         h.wave_time_s,
         h.compute_ms,
+        service::wall_s(),
         vessels.join(","),
         fl.join(",")
     )
@@ -404,4 +405,164 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Stop after this many seconds (default: until Ctrl-C).
+    #[arg(long)]
+    seconds: Option<f64>,
+}
+
+/// Kills a child with SIGINT, then waits (SIGKILL after 5 s).
+struct Child(std::process::Child);
+
+impl Drop for Child {
+    fn drop(&mut self) {
+        let _ = std::process::Command::new("kill")
+            .args(["-INT", &self.0.id().to_string()])
+            .status();
+        let t = Instant::now();
+        while t.elapsed() < Duration::from_secs(5) {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `shipcast demo`: the synthetic sea publishing radar and IMU data, the daemon on the bundled demo,
+/// and a live view of the forecasts and of their skill so far (the forecasts of 30 s ago against the
+/// motion measured now). Ctrl-C stops all three.
+pub fn demo(a: &DemoArgs) -> Result<()> {
+    use shipcast::ipc::MotionSubscriber;
+    let cfg = load_config(&a.config)?;
+    let sys = files::load_system(&system_path(&cfg))?.system;
+    let exe = std::env::current_exe()?;
+    let config = a.config.to_str().context("config path is not UTF-8")?.to_string();
+    let spawn = |args: &[&str]| -> Result<Child> {
+        Ok(Child(
+            std::process::Command::new(&exe)
+                .args(args)
+                .stdout(std::process::Stdio::null())
+                .spawn()
+                .with_context(|| format!("starting shipcast {}", args[0]))?,
+        ))
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    ctrlc_flag(stop.clone())?;
+    println!(
+        "shipcast demo: {} vessels ({}), sea Hs {} m Tp {} s, radar {} m; starting the daemon and the synthetic sea (Ctrl-C stops all)",
+        sys.spec.bodies.len(),
+        sys.spec
+            .bodies
+            .iter()
+            .map(|b| b.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        cfg.simulate.sea.hs_m,
+        cfg.simulate.sea.tp_s,
+        cfg.simulate.radar.radius_m
+    );
+    let _daemon = spawn(&["run", "--config", &config])?;
+    std::thread::sleep(Duration::from_millis(1500));
+    let _sim = spawn(&["simulate", "--publish", "--config", &config])?;
+    let names = Names {
+        prefix: cfg.ipc.service_prefix.clone(),
+    };
+    let sub = ForecastSubscriber::new(&names).map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+    let motion = MotionSubscriber::new(&names).map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+    const LEAD: f64 = 30.0;
+    let mut pending: Vec<(f64, f64)> = vec![]; // (valid time, forecast heave of vessel 0)
+    let mut measured: std::collections::VecDeque<(f64, f64)> = Default::default();
+    let (mut pairs_f, mut pairs_m) = (vec![], vec![]);
+    let mut got = vec![];
+    let mut samples = vec![];
+    let start = Instant::now();
+    let name0 = sys.spec.bodies[0].name.clone();
+    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+        if a.seconds.is_some_and(|s| start.elapsed().as_secs_f64() > s) {
+            break;
+        }
+        got.clear();
+        sub.wait(Duration::from_millis(500), &mut got)
+            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+        samples.clear();
+        motion
+            .drain(&mut samples)
+            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+        for s in samples.iter().filter(|s| s.vessel == 0) {
+            measured.push_back((s.time_s, s.x[2]));
+        }
+        while measured.len() > 5000 {
+            measured.pop_front();
+        }
+        // score the forecasts whose valid time has been measured
+        pending.retain(|(t, f)| {
+            let Some(i) = measured.iter().position(|(tm, _)| *tm >= *t) else {
+                return true;
+            };
+            if i > 0 {
+                let (t0, x0) = measured[i - 1];
+                let (t1, x1) = measured[i];
+                let m = x0 + (x1 - x0) * (t - t0) / (t1 - t0);
+                pairs_f.push(*f);
+                pairs_m.push(m);
+            }
+            false
+        });
+        for r in &got {
+            if let Received::Forecast(h, v) = r {
+                let n = h.steps as usize + 1;
+                let k = (LEAD / h.dt_s).round() as usize;
+                let heave = &v[2 * n..3 * n];
+                if k < n {
+                    pending.push((h.issue_time_s + LEAD, heave[k]));
+                }
+                let skill = if pairs_f.len() >= 10 {
+                    format!(
+                        "skill at {LEAD:.0} s so far: correlation {:.3} over {} forecasts",
+                        correlation(&pairs_f, &pairs_m),
+                        pairs_f.len()
+                    )
+                } else {
+                    format!(
+                        "skill at {LEAD:.0} s: waiting for the measured motion ({} scored)",
+                        pairs_f.len()
+                    )
+                };
+                let fl = if h.flags != 0 {
+                    format!(" [{}]", flags::names(h.flags).join(", "))
+                } else {
+                    String::new()
+                };
+                println!(
+                    "{name0} heave now {:+.2} m, in {LEAD:.0} s {:+.2} m, horizon {:.0} s, computed in {:.0} ms; {skill}{fl}",
+                    heave[0],
+                    heave[k.min(n - 1)],
+                    h.horizon_s[0],
+                    h.compute_ms
+                );
+            }
+        }
+    }
+    println!("shipcast demo: stopping");
+    Ok(())
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
 }

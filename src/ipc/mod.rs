@@ -464,3 +464,29 @@ impl ForecastSubscriber {
         self.drain(out)
     }
 }
+
+/// A subscriber of the motion stream (the demo's live skill, consoles drawing the measured past).
+pub struct MotionSubscriber {
+    _node: Node<ipc::Service>,
+    motion: Subscriber<ipc::Service, MotionSample, ()>,
+}
+
+impl MotionSubscriber {
+    pub fn new(names: &Names) -> Result<MotionSubscriber> {
+        let node = node()?;
+        let motion = motion_service(&node, names)?
+            .subscriber_builder()
+            .buffer_size(BUFFER)
+            .create()
+            .map_err(err)?;
+        Ok(MotionSubscriber { _node: node, motion })
+    }
+
+    /// Every sample received so far.
+    pub fn drain(&self, out: &mut Vec<MotionSample>) -> Result<()> {
+        while let Some(s) = self.motion.receive().map_err(err)? {
+            out.push(*s.payload());
+        }
+        Ok(())
+    }
+}
