@@ -90,6 +90,9 @@ pub struct ForecastConfig {
     pub max_gap_s: f64,
     /// Motion samples kept per vessel beyond the radiation memory, s.
     pub history_margin_s: f64,
+    /// Of a received wave field, the largest components holding this fraction of its variance are kept
+    /// (a radar inversion has one per wavenumber bin, mostly noise; the cost is linear in their number).
+    pub wave_variance_kept: f64,
 }
 
 impl Default for ForecastConfig {
@@ -105,6 +108,7 @@ impl Default for ForecastConfig {
             max_motion_age_s: 2.0,
             max_gap_s: 1.0,
             history_margin_s: 10.0,
+            wave_variance_kept: 0.995,
         }
     }
 }
@@ -285,6 +289,12 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     pos("forecast.suppress_wave_age_s", f.suppress_wave_age_s)?;
     pos("forecast.max_motion_age_s", f.max_motion_age_s)?;
     pos("forecast.max_gap_s", f.max_gap_s)?;
+    if !(f.wave_variance_kept > 0.0 && f.wave_variance_kept <= 1.0) {
+        return Err((
+            "forecast.wave_variance_kept".into(),
+            format!("must be in (0, 1], found {}", f.wave_variance_kept),
+        ));
+    }
     if f.horizon_s > 3600.0 {
         return Err((
             "forecast.horizon_s".into(),

@@ -276,6 +276,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                     }
                     Input::Waves(f) => {
                         c.wave_fields += 1;
+                        let f = f.pruned(cfg.forecast.wave_variance_kept);
                         if field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
                             field = Some(f);
                         }

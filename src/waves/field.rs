@@ -154,6 +154,32 @@ impl WaveField {
             .collect()
     }
 
+    /// The largest components that together hold `fraction` of the variance (a radar inversion gives one
+    /// per wavenumber bin, most of them noise: the forecast's cost is proportional to their number).
+    pub fn pruned(&self, fraction: f64) -> WaveField {
+        let mut idx: Vec<usize> = (0..self.components.len()).collect();
+        idx.sort_by(|a, b| {
+            self.components[*b]
+                .amplitude_m
+                .norm_sqr()
+                .total_cmp(&self.components[*a].amplitude_m.norm_sqr())
+        });
+        let total = self.variance_m2();
+        let mut acc = 0.0;
+        let mut keep = vec![];
+        for i in idx {
+            if acc >= fraction * total {
+                break;
+            }
+            acc += 0.5 * self.components[i].amplitude_m.norm_sqr();
+            keep.push(self.components[i]);
+        }
+        WaveField {
+            components: keep,
+            ..self.clone()
+        }
+    }
+
     /// Variance sum |a|^2 / 2, m^2.
     pub fn variance_m2(&self) -> f64 {
         self.components.iter().map(|c| 0.5 * c.amplitude_m.norm_sqr()).sum()
@@ -231,6 +257,17 @@ mod tests {
             .sum();
         assert!((e - f.elevation_at(pos, 1008.0)).abs() < 1e-12);
         assert!((comps[0].heading_rad - (0.3 - 1.1)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn pruning_keeps_the_largest_components() {
+        let f = field();
+        let total = f.variance_m2();
+        let p = f.pruned(0.5);
+        assert_eq!(p.components.len(), 1);
+        assert_eq!(p.components[0], f.components[0]);
+        assert!(p.variance_m2() >= 0.5 * total);
+        assert_eq!(f.pruned(1.0).components.len(), 2);
     }
 
     #[test]
