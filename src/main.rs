@@ -649,28 +649,15 @@ fn scenario_horizons(
     sc: &Scenario,
     waves: &[shipcast::waves::WaveComponent],
 ) -> Vec<(String, f64)> {
-    use shipcast::waves::field::{FieldComponent, Region, WaveField};
-    let field = WaveField {
-        components: waves
-            .iter()
-            .map(|c| FieldComponent {
-                omega_rad_s: c.omega_rad_s,
-                direction_rad: c.heading_rad,
-                amplitude_m: c.amplitude_m,
-            })
-            .collect(),
-        reference_m: [0.0, 0.0],
-        time_s: 0.0,
-        g_m_s2: sys.spec.g_m_s2,
-        depth_m: sys.spec.water_depth_m,
-        region: match sc.radar_radius_m {
-            Some(r) => Region::Disc {
-                centre_m: [0.0, 0.0],
-                radius_m: r,
-            },
-            None => Region::Everywhere,
+    use shipcast::waves::field::{Region, WaveField};
+    let region = match sc.radar_radius_m {
+        Some(r) => Region::Disc {
+            centre_m: [0.0, 0.0],
+            radius_m: r,
         },
+        None => Region::Everywhere,
     };
+    let field = WaveField::from_components(waves, sys.spec.g_m_s2, sys.spec.water_depth_m, region);
     sys.spec
         .bodies
         .iter()

@@ -8,8 +8,8 @@
 //! origin at `origin_m`. Times are seconds from the start of the simulation.
 
 use crate::hydro::VesselSystem;
-use crate::rom::{self, Forecast, ForecastRequest, Forecaster, Memory, RomOptions, TimeModel};
-use crate::waves::field::{FieldComponent, Region, WaveField};
+use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel};
+use crate::waves::field::{Region, WaveField};
 use crate::waves::observe::{Grid, GridOptions, from_grids};
 use crate::waves::sea::{SeaState, realize_all};
 use rand::{Rng, SeedableRng};
@@ -91,33 +91,16 @@ impl Simulation {
             b.linear_damping *= spec.damping_factor;
         }
         let model = TimeModel::new(&truth_sys, opts)?;
-        let sea = WaveField {
-            components: realize_all(&spec.seas)
-                .into_iter()
-                .map(|c| FieldComponent {
-                    omega_rad_s: c.omega_rad_s,
-                    direction_rad: c.heading_rad,
-                    amplitude_m: c.amplitude_m,
-                })
-                .collect(),
-            reference_m: [0.0, 0.0],
-            time_s: 0.0,
-            g_m_s2: sys.spec.g_m_s2,
-            depth_m: sys.spec.water_depth_m,
-            region: Region::Everywhere,
-        };
+        let sea = WaveField::from_components(
+            &realize_all(&spec.seas),
+            sys.spec.g_m_s2,
+            sys.spec.water_depth_m,
+            Region::Everywhere,
+        );
         let waves = sea.for_vessel(spec.origin_m, spec.heading_rad, 0.0);
-        let z = vec![0.0; model.n()];
-        let memory = Memory::new(&model);
-        let req = ForecastRequest {
-            x0: &z,
-            v0: &z,
-            memory: &memory,
-            waves: &waves,
-            horizon_s: spec.duration_s,
-            ramp_s: spec.ramp_s,
-        };
-        let truth = Forecaster::new().forecast(&model, &req)?.clone();
+        let truth = Forecaster::new()
+            .from_rest(&model, &waves, spec.duration_s, spec.ramp_s)?
+            .clone();
         Ok(Simulation {
             n_bodies: sys.spec.bodies.len(),
             rng: ChaCha8Rng::seed_from_u64(spec.seed ^ 0x5eed),

@@ -340,18 +340,10 @@ fn two_ships_moored_together_stay_stable_in_beam_seas_for_30_minutes() {
         seed: 7,
     };
     let waves: Vec<WaveComponent> = shipcast::waves::sea::realize(&sea);
-    let mem = Memory::new(&m);
-    let z = vec![0.0; m.n()];
-    let req = ForecastRequest {
-        x0: &z,
-        v0: &z,
-        memory: &mem,
-        waves: &waves,
-        horizon_s: 1800.0,
-        ramp_s: 60.0,
-    };
     let mut fc = Forecaster::new();
-    let f = fc.forecast(&m, &req).expect("30 minutes without divergence");
+    let f = fc
+        .from_rest(&m, &waves, 1800.0, 60.0)
+        .expect("30 minutes without divergence");
     let d = shipcast::rom::outputs::derived(&sys.spec.external, f);
     let col = |n: &str| d.column(n).unwrap_or_else(|| panic!("{n}"));
     let max_of = |c: usize| (0..=f.steps).map(|k| d.at(k, c)).fold(f64::MIN, f64::max);

@@ -3,7 +3,7 @@
 
 use num_complex::Complex64;
 use rustfft::FftPlanner;
-use shipcast::waves::field::{FieldComponent, Region, WaveField, group_velocity};
+use shipcast::waves::field::{Region, WaveField, group_velocity};
 use shipcast::waves::horizon::{self, PlanningSea, Spreading};
 use shipcast::waves::observe::{Grid, GridOptions, from_grids, from_probe};
 use shipcast::waves::sea::{SeaState, jonswap, realize};
@@ -37,20 +37,18 @@ fn sea(seed: u64, components: usize) -> SeaState {
 
 /// A realization as an earth-frame field (direction = heading: the vessel frame is east-aligned).
 fn field_of(sea: &SeaState) -> WaveField {
-    WaveField {
-        components: realize(sea)
-            .into_iter()
-            .map(|c| FieldComponent {
-                omega_rad_s: c.omega_rad_s,
-                direction_rad: c.heading_rad,
-                amplitude_m: c.amplitude_m,
-            })
-            .collect(),
-        reference_m: [0.0, 0.0],
-        time_s: 0.0,
+    WaveField::from_components(&realize(sea), G, None, Region::Everywhere)
+}
+
+/// The radar processor's options: deep water, the realizations' band, no hint.
+fn grid_options(region: Option<Region>) -> GridOptions {
+    GridOptions {
         g_m_s2: G,
         depth_m: None,
-        region: Region::Everywhere,
+        omega_min_rad_s: 0.25,
+        omega_max_rad_s: 1.45,
+        mean_direction_rad: None,
+        region,
     }
 }
 
@@ -151,14 +149,7 @@ fn radar_grid_predicts_a_point_1_km_away_within_the_horizon() {
     let truth = field_of(&s);
     // 128 x 128 cells of 15 m, three snapshots 1.5 s apart, 5 cm noise
     let grids = radar(&truth, 128, 15.0, &[-3.0, -1.5, 0.0], 0.05, f64::INFINITY, 1);
-    let opts = GridOptions {
-        g_m_s2: G,
-        depth_m: None,
-        omega_min_rad_s: 0.25,
-        omega_max_rad_s: 1.45,
-        mean_direction_rad: None,
-        region: None,
-    };
+    let opts = grid_options(None);
     let f = from_grids(&grids, &opts).unwrap();
     let p = [1000.0, 0.0];
     let h = horizon::of_field(&f, p, [0.0, 0.0], 0.0);
@@ -196,14 +187,7 @@ fn opposite_swell_and_wind_sea_are_separated_by_a_sequence() {
     };
     truth.components.extend(field_of(&swell).components);
     let grids = radar(&truth, 128, 15.0, &[-3.0, -1.5, 0.0], 0.02, f64::INFINITY, 2);
-    let opts = GridOptions {
-        g_m_s2: G,
-        depth_m: None,
-        omega_min_rad_s: 0.25,
-        omega_max_rad_s: 1.45,
-        mean_direction_rad: None,
-        region: None,
-    };
+    let opts = grid_options(None);
     let f = from_grids(&grids, &opts).unwrap();
     let energy = |west: bool| -> f64 {
         f.components
@@ -317,17 +301,10 @@ fn skill_of_a_synthetic_radar_falls_past_the_horizon_and_not_before() {
         let grids = radar(&truth, 128, 15.0, &[-3.0, -1.5, 0.0], 0.05, r, seed);
         let f = from_grids(
             &grids,
-            &GridOptions {
-                g_m_s2: G,
-                depth_m: None,
-                omega_min_rad_s: 0.25,
-                omega_max_rad_s: 1.45,
-                mean_direction_rad: None,
-                region: Some(Region::Disc {
-                    centre_m: [0.0, 0.0],
-                    radius_m: r,
-                }),
-            },
+            &grid_options(Some(Region::Disc {
+                centre_m: [0.0, 0.0],
+                radius_m: r,
+            })),
         )
         .unwrap();
         before.push(nrmse(&f, &truth, [0.0, 0.0], 0.0, 0.8 * hz));

@@ -9,35 +9,40 @@ const FD_TOL: f64 = 0.003;
 /// Wave amplitude of the reference runs, m (H = 2.5 m).
 const AMPLITUDE_M: f64 = 1.25;
 
-#[test]
-fn frequency_domain_heave_at_8_s_matches_reference() {
-    let omega = 2.0 * std::f64::consts::PI / 8.0;
+/// Runs `shipcast rao` on the RM3 system at T = 8 s with `method` and checks both heave RAOs against
+/// the exact frequency-domain reference (README of the reference data, per 1.25 m amplitude).
+fn heave_at_8_s(method: &str, tol: f64) -> Vec<crate::util::RaoRow> {
     let (ok, out, err) = shipcast(&[
         "rao",
         "tests/data/wecsim-rm3/system.toml",
         "--method",
-        "frequency",
+        method,
         "--heading",
         "0",
         "--omega",
-        &format!("{omega}"),
+        "0.785398",
     ]);
     assert!(ok, "{err}");
     let rows = parse_rao_csv(&out);
-    // reference README: exact frequency-domain solve of the same WAMIT data, per 1.25 m amplitude
     for (mode, amp_ref, phase_ref) in [(3, 0.98395, -24.83), (9, 0.12408, -43.31)] {
         let r = rows.iter().find(|r| r.mode == mode).unwrap();
         let (re, im) = r.complex();
         let p = f64::to_radians(phase_ref);
         let err = (re * AMPLITUDE_M - amp_ref * p.cos()).hypot(im * AMPLITUDE_M - amp_ref * p.sin()) / amp_ref;
         eprintln!(
-            "mode {mode}: {:.5} m / {:.2} deg, reference {amp_ref} / {phase_ref}: error {:.3e}",
+            "{method} mode {mode}: {:.5} m / {:.2} deg, reference {amp_ref} / {phase_ref}: error {:.3e}",
             r.amplitude * AMPLITUDE_M,
             r.phase_deg,
             err
         );
-        assert!(err <= FD_TOL, "mode {mode}: error {err}");
+        assert!(err <= tol, "{method} mode {mode}: error {err}");
     }
+    rows
+}
+
+#[test]
+fn frequency_domain_heave_at_8_s_matches_reference() {
+    let rows = heave_at_8_s("frequency", FD_TOL);
     // inactive modes are held at zero
     assert!(
         rows.iter()
@@ -52,29 +57,5 @@ const TD_TOL: f64 = 0.005;
 
 #[test]
 fn time_domain_heave_at_8_s_with_the_damper_as_a_connection() {
-    let (ok, out, err) = shipcast(&[
-        "rao",
-        "tests/data/wecsim-rm3/system.toml",
-        "--method",
-        "time",
-        "--heading",
-        "0",
-        "--omega",
-        "0.785398",
-    ]);
-    assert!(ok, "{err}");
-    let rows = parse_rao_csv(&out);
-    for (mode, amp_ref, phase_ref) in [(3, 0.98395, -24.83), (9, 0.12408, -43.31)] {
-        let r = rows.iter().find(|r| r.mode == mode).unwrap();
-        let (re, im) = r.complex();
-        let p = f64::to_radians(phase_ref);
-        let err = (re * AMPLITUDE_M - amp_ref * p.cos()).hypot(im * AMPLITUDE_M - amp_ref * p.sin()) / amp_ref;
-        eprintln!(
-            "time domain mode {mode}: {:.5} m / {:.2} deg, reference {amp_ref} / {phase_ref}: error {:.3e}",
-            r.amplitude * AMPLITUDE_M,
-            r.phase_deg,
-            err
-        );
-        assert!(err <= TD_TOL, "mode {mode}: error {err}");
-    }
+    heave_at_8_s("time", TD_TOL);
 }

@@ -167,19 +167,8 @@ fn motions_after_the_ramp_match_wecsim() {
     let r = Reference::load();
     let omega = 2.0 * std::f64::consts::PI / 8.0;
     let (_, m) = model(RadiationMethod::Constant { omega_rad_s: omega });
-    let mem = Memory::new(&m);
-    let z = vec![0.0; m.n()];
-    let waves = wave();
-    let req = ForecastRequest {
-        x0: &z,
-        v0: &z,
-        memory: &mem,
-        waves: &waves,
-        horizon_s: DURATION_S,
-        ramp_s: RAMP_S,
-    };
     let mut fc = Forecaster::new();
-    let f = fc.forecast(&m, &req).unwrap();
+    let f = fc.from_rest(&m, &wave(), DURATION_S, RAMP_S).unwrap();
     let from = (RAMP_S / 0.1) as usize;
     let mut report = vec![];
     for (b, body) in BODIES.iter().enumerate() {

@@ -228,6 +228,27 @@ impl Forecaster {
         Ok(&self.out)
     }
 
+    /// A run from rest with no past (simulations, regular-wave runs, tests).
+    pub fn from_rest(
+        &mut self,
+        model: &TimeModel,
+        waves: &[WaveComponent],
+        horizon_s: f64,
+        ramp_s: f64,
+    ) -> Result<&Forecast> {
+        let z = vec![0.0; model.n()];
+        let memory = Memory::new(model);
+        let req = ForecastRequest {
+            x0: &z,
+            v0: &z,
+            memory: &memory,
+            waves,
+            horizon_s,
+            ramp_s,
+        };
+        self.forecast(model, &req)
+    }
+
     /// Adds to `known` the convolution of the forecast velocities j0..j0+B-1 with the kernel, for every
     /// later output up to `steps`, by FFT.
     fn block_part(&mut self, model: &TimeModel, j0: usize, steps: usize) -> Result<()> {

@@ -62,6 +62,31 @@ pub fn heading_from_compass_deg(compass_deg: f64) -> f64 {
 }
 
 impl WaveField {
+    /// A field from components given in a frame whose x axis points east (a scenario's or a
+    /// realization's: heading = direction), referred to the origin at t = 0.
+    pub fn from_components(
+        components: &[WaveComponent],
+        g_m_s2: f64,
+        depth_m: Option<f64>,
+        region: Region,
+    ) -> WaveField {
+        WaveField {
+            components: components
+                .iter()
+                .map(|c| FieldComponent {
+                    omega_rad_s: c.omega_rad_s,
+                    direction_rad: c.heading_rad,
+                    amplitude_m: c.amplitude_m,
+                })
+                .collect(),
+            reference_m: [0.0, 0.0],
+            time_s: 0.0,
+            g_m_s2,
+            depth_m,
+            region,
+        }
+    }
+
     /// Checks every component: positive finite frequency, finite direction and amplitude.
     pub fn validate(&self) -> Result<()> {
         for (i, c) in self.components.iter().enumerate() {
