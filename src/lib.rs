@@ -1,8 +1,8 @@
 //! shipcast: real-time motion forecasts for one or more ships, from a Cummins reduced-order model driven
 //! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
 //!
-//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`].
-//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports),
+//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`], [`skill`].
+//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports), [`replay`] (MCAP logs),
 //! [`service`] (the daemon) and the `shipcast` binary.
 
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
@@ -12,8 +12,10 @@ pub mod files;
 pub mod hydro;
 pub mod ipc;
 pub mod rao;
+pub mod replay;
 pub mod rom;
 pub mod scenario;
 pub mod service;
 pub mod sim;
+pub mod skill;
 pub mod waves;

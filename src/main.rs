@@ -50,6 +50,8 @@ enum Command {
     Watch(cli::daemon::WatchArgs),
     /// One command to try it: the synthetic sea, the daemon and a live view of forecasts and skill.
     Demo(cli::daemon::DemoArgs),
+    /// A recorded log through the daemon's engine; with --report, skill against lead time.
+    Replay(cli::replay::ReplayArgs),
 }
 
 #[derive(Args, Debug)]
@@ -245,6 +247,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Simulate(args) => cli::daemon::simulate(&args),
         Command::Watch(args) => cli::daemon::watch(&args),
         Command::Demo(args) => cli::daemon::demo(&args),
+        Command::Replay(args) => cli::replay::run(&args),
     }
 }
 

@@ -15,6 +15,10 @@ use crate::waves::sea::{SeaState, realize_all};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// The simulated processor publishes the largest components holding this share of the inverted
+/// field's variance (one per wavenumber bin otherwise: thousands, mostly noise).
+pub const PROCESSOR_VARIANCE_KEPT: f64 = 0.995;
+
 /// The radar and its processor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RadarSpec {
@@ -193,7 +197,9 @@ impl Simulation {
                 radius_m: r.radius_m,
             }),
         };
-        from_grids(&self.grids, &opts).ok()
+        from_grids(&self.grids, &opts)
+            .ok()
+            .map(|f| f.pruned(PROCESSOR_VARIANCE_KEPT))
     }
 }
 

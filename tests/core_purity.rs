@@ -10,7 +10,7 @@ const CORE: &[&str] = &[
     "src/rao.rs",
     "src/waves",
     "src/rom",
-    "src/skill",
+    "src/skill.rs",
     "src/sim.rs",
     "src/service/history.rs",
 ];

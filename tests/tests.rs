@@ -11,6 +11,7 @@ mod daemon;
 mod external_models;
 mod forecast_cli;
 mod kramers_kronig;
+mod replay;
 mod rom;
 mod waves_fields;
 mod wecsim_rm3;

@@ -35,6 +35,9 @@ pub struct SimulateArgs {
     /// Write the true motion (t_s and every body DOF, at the IMU rate) to this CSV.
     #[arg(long)]
     truth: Option<PathBuf>,
+    /// Write the sensor streams and the truth to this log (MCAP), as fast as possible.
+    #[arg(long, conflicts_with = "publish")]
+    record: Option<PathBuf>,
     /// Simulated duration, s (default: simulate.duration_s).
     #[arg(long)]
     duration: Option<f64>,
@@ -155,6 +158,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         }
         None => None,
     };
+    let mut recorder = match &a.record {
+        Some(p) => Some(shipcast::replay::Recorder::create(p).map_err(|e| anyhow::anyhow!("{e}"))?),
+        None => None,
+    };
     let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
     let radar_dt = cfg.simulate.radar.period_s;
     let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
@@ -186,6 +193,49 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                 p.motion(&to_wire(&s))
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
+        } else if let Some(rec) = recorder.as_mut() {
+            use shipcast::replay::{MotionRecord, WavesRecord};
+            let e = |e| {
+                anyhow::anyhow!(
+                    "{}: {e}",
+                    a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
+                )
+            };
+            if next_radar <= next_imu {
+                if let Some(f) = sim.radar(t) {
+                    rec.write("/waves", t, &WavesRecord::of(&f)).map_err(e)?;
+                }
+                next_radar += radar_dt;
+                continue;
+            }
+            for s in sim.imu(t) {
+                rec.write(
+                    "/motion",
+                    t,
+                    &MotionRecord {
+                        vessel: s.vessel as u32,
+                        time_s: t,
+                        x: s.x,
+                        v: s.v,
+                    },
+                )
+                .map_err(e)?;
+                let mut x = [0.0; 6];
+                for (d, xd) in x.iter_mut().enumerate() {
+                    *xd = sim.true_x(t, 6 * s.vessel + d);
+                }
+                rec.write(
+                    "/truth",
+                    t,
+                    &MotionRecord {
+                        vessel: s.vessel as u32,
+                        time_s: t,
+                        x,
+                        v: [0.0; 6],
+                    },
+                )
+                .map_err(e)?;
+            }
         } else if next_radar <= next_imu {
             next_radar += radar_dt;
             continue;
@@ -202,6 +252,13 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     }
     if let Some(mut f) = truth_out {
         f.flush()?;
+    }
+    if let Some(rec) = recorder {
+        rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
+        eprintln!(
+            "shipcast simulate: {duration} s recorded in {:.1} s",
+            t.elapsed().as_secs_f64()
+        );
     }
     Ok(())
 }

@@ -1,5 +1,10 @@
 //! The forecasting daemon (shell): configuration, motion history, cadence, health, shutdown.
 //!
+//! [`Engine`] holds the state and makes every decision (what to drop, when a forecast is possible, its
+//! flags and horizon, the status) against a clock it is given; [`Computer`] runs a forecast job. The
+//! live daemon ([`run`]) feeds them from iceoryx2 and a wall-clock cadence; replay feeds the same two from
+//! a log's clock: one code path.
+//!
 //! Threads: the tokio runtime owns the state (histories, the newest wave field, counters) and the
 //! cadence; the iceoryx2 input and output threads ([`crate::ipc`]) bridge to it with channels; the
 //! forecast itself runs on a compute thread of its own so a slow forecast never blocks the ports. A
@@ -11,7 +16,7 @@ pub mod config;
 pub mod history;
 
 use crate::hydro::VesselSystem;
-use crate::ipc::wire::{self, ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
+use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
 use crate::ipc::{self, Input, Names, Output};
 use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
 use crate::waves::field::{WaveField, heading_from_compass_deg};
@@ -64,8 +69,9 @@ pub fn vessel_positions(cfg: &ShipcastConfig, sys: &VesselSystem) -> (Vec<[f64; 
     (pos, h)
 }
 
-/// One forecast job for the compute thread.
-struct Job {
+/// One forecast job.
+#[derive(Debug, Clone)]
+pub struct Job {
     t0_s: f64,
     x0: Vec<f64>,
     v0: Vec<f64>,
@@ -74,64 +80,89 @@ struct Job {
     header: ForecastHeader,
 }
 
-struct Done {
-    header: ForecastHeader,
-    values: Option<Vec<f64>>,
-    compute_ms: f64,
-    error: Option<String>,
+/// A job's result.
+#[derive(Debug, Clone)]
+pub struct Done {
+    pub header: ForecastHeader,
+    pub values: Option<Vec<f64>>,
+    pub compute_ms: f64,
+    pub error: Option<String>,
+}
+
+/// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
+pub struct Computer {
+    model: TimeModel,
+    fc: Forecaster,
+    n_bodies: usize,
+    horizon_s: f64,
+}
+
+impl Computer {
+    pub fn new(model: TimeModel, n_bodies: usize, horizon_s: f64) -> Computer {
+        Computer {
+            model,
+            fc: Forecaster::new(),
+            n_bodies,
+            horizon_s,
+        }
+    }
+
+    /// Runs one job; `elapsed_ms` measures its compute time (the shell passes a clock).
+    pub fn run(&mut self, job: Job, elapsed_ms: impl Fn() -> f64) -> Done {
+        let (model, n_bodies) = (&self.model, self.n_bodies);
+        let fc = &mut self.fc;
+        let result = Memory::from_history(model, &job.velocities).and_then(|memory| {
+            let req = ForecastRequest {
+                x0: &job.x0,
+                v0: &job.v0,
+                memory: &memory,
+                waves: &job.waves,
+                horizon_s: self.horizon_s,
+                ramp_s: 0.0,
+            };
+            fc.forecast(model, &req).map(|f| {
+                let mut values = Vec::with_capacity(6 * n_bodies * (f.steps + 1));
+                for i in 0..6 * n_bodies {
+                    values.extend((0..=f.steps).map(|k| f.at(k, i)));
+                }
+                (values, f.steps)
+            })
+        });
+        let compute_ms = elapsed_ms();
+        let mut header = job.header;
+        header.compute_ms = compute_ms;
+        header.issue_time_s = job.t0_s;
+        match result {
+            Ok((values, steps)) => {
+                header.steps = steps as u32;
+                Done {
+                    header,
+                    values: Some(values),
+                    compute_ms,
+                    error: None,
+                }
+            }
+            Err(e) => Done {
+                header,
+                values: None,
+                compute_ms,
+                error: Some(e.to_string()),
+            },
+        }
+    }
 }
 
 fn compute_thread(
-    model: TimeModel,
-    n_bodies: usize,
-    horizon_s: f64,
+    mut computer: Computer,
     jobs: std::sync::mpsc::Receiver<Job>,
     done: tokio::sync::mpsc::Sender<Done>,
 ) -> std::thread::JoinHandle<()> {
     std::thread::Builder::new()
         .name("shipcast-compute".into())
         .spawn(move || {
-            let mut fc = Forecaster::new();
             while let Ok(job) = jobs.recv() {
                 let t = Instant::now();
-                let result = Memory::from_history(&model, &job.velocities).and_then(|memory| {
-                    let req = ForecastRequest {
-                        x0: &job.x0,
-                        v0: &job.v0,
-                        memory: &memory,
-                        waves: &job.waves,
-                        horizon_s,
-                        ramp_s: 0.0,
-                    };
-                    fc.forecast(&model, &req).map(|f| {
-                        let mut values = Vec::with_capacity(6 * n_bodies * (f.steps + 1));
-                        for i in 0..6 * n_bodies {
-                            values.extend((0..=f.steps).map(|k| f.at(k, i)));
-                        }
-                        (values, f.steps)
-                    })
-                });
-                let compute_ms = t.elapsed().as_secs_f64() * 1e3;
-                let mut header = job.header;
-                header.compute_ms = compute_ms;
-                header.issue_time_s = job.t0_s;
-                let msg = match result {
-                    Ok((values, steps)) => {
-                        header.steps = steps as u32;
-                        Done {
-                            header,
-                            values: Some(values),
-                            compute_ms,
-                            error: None,
-                        }
-                    }
-                    Err(e) => Done {
-                        header,
-                        values: None,
-                        compute_ms,
-                        error: Some(e.to_string()),
-                    },
-                };
+                let msg = computer.run(job, || t.elapsed().as_secs_f64() * 1e3);
                 if done.blocking_send(msg).is_err() {
                     break;
                 }
@@ -140,19 +171,261 @@ fn compute_thread(
         .expect("spawning the compute thread")
 }
 
-#[derive(Default)]
-struct Counters {
-    forecasts: u64,
-    overruns: u64,
-    samples: u64,
-    wave_fields: u64,
-    nonfinite: u64,
-    late: u64,
-    duplicate: u64,
-    rejected: u64,
+#[derive(Debug, Clone, Default)]
+pub struct Counters {
+    pub forecasts: u64,
+    pub overruns: u64,
+    pub samples: u64,
+    pub wave_fields: u64,
+    pub nonfinite: u64,
+    pub late: u64,
+    pub duplicate: u64,
+    pub rejected: u64,
 }
 
-/// Runs the daemon until SIGINT/SIGTERM or `stop` is set. `on_ready` is called once the ports are up.
+/// The daemon's state and decisions, driven by a clock the caller supplies (seconds: monotonic wall
+/// time live, the log's time in replay): the same code for both.
+pub struct Engine {
+    cfg: config::ForecastConfig,
+    origin_m: [f64; 2],
+    n_bodies: usize,
+    taps: usize,
+    active: Vec<usize>,
+    n_active: usize,
+    positions: Vec<[f64; 2]>,
+    heading: f64,
+    hist: Vec<History>,
+    /// Clock time of each vessel's newest accepted sample.
+    arrival: Vec<Option<f64>>,
+    field: Option<WaveField>,
+    pub counters: Counters,
+    busy: bool,
+    last_forecast_time: f64,
+    last_compute_ms: f64,
+    last_horizon: [f64; MAX_VESSELS],
+    state_flags: u32,
+}
+
+impl Engine {
+    pub fn new(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeModel) -> Engine {
+        let n_bodies = sys.spec.bodies.len();
+        let taps = match &model.kernel {
+            crate::rom::model::Kernel::Convolution { taps, .. } => *taps,
+            crate::rom::model::Kernel::StateSpace { .. } => {
+                (cfg.forecast.memory_s.unwrap_or(120.0) / cfg.forecast.dt_s).round() as usize
+            }
+        };
+        let keep_s = taps as f64 * cfg.forecast.dt_s + cfg.forecast.history_margin_s;
+        let (positions, heading) = vessel_positions(cfg, sys);
+        Engine {
+            cfg: cfg.forecast.clone(),
+            origin_m: [cfg.site.origin_east_m, cfg.site.origin_north_m],
+            n_bodies,
+            taps,
+            active: model.active.clone(),
+            n_active: model.n(),
+            positions,
+            heading,
+            hist: (0..n_bodies).map(|_| History::new(keep_s)).collect(),
+            arrival: vec![None; n_bodies],
+            field: None,
+            counters: Counters::default(),
+            busy: false,
+            last_forecast_time: -1.0,
+            last_compute_ms: 0.0,
+            last_horizon: [0.0; MAX_VESSELS],
+            state_flags: 0,
+        }
+    }
+
+    /// Radiation memory the engine keeps, s.
+    pub fn memory_s(&self) -> f64 {
+        self.taps as f64 * self.cfg.dt_s
+    }
+
+    pub fn input(&mut self, msg: Input, clock_s: f64) {
+        let c = &mut self.counters;
+        match msg {
+            Input::Motion(m) => {
+                c.samples += 1;
+                let b = m.vessel as usize;
+                if m.schema_version != SCHEMA_VERSION || b >= self.n_bodies {
+                    c.rejected += 1;
+                    return;
+                }
+                match self.hist[b].push(Sample {
+                    time_s: m.time_s,
+                    x: m.x,
+                    v: m.v,
+                }) {
+                    Ok(()) => self.arrival[b] = Some(clock_s),
+                    Err(Drop::NonFinite) => c.nonfinite += 1,
+                    Err(Drop::Late) => c.late += 1,
+                    Err(Drop::Duplicate) => c.duplicate += 1,
+                }
+            }
+            Input::Waves(f) => {
+                c.wave_fields += 1;
+                let f = f.pruned(self.cfg.wave_variance_kept);
+                if self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+                    self.field = Some(f);
+                }
+            }
+            Input::Rejected(why) => {
+                c.rejected += 1;
+                tracing::warn!("input rejected: {why}");
+            }
+        }
+    }
+
+    /// One cadence tick at `clock_s`: the flags of the moment and, when the inputs allow and no
+    /// forecast is running, the job to run (a tick while one runs is an overrun).
+    pub fn tick(&mut self, clock_s: f64) -> Option<Job> {
+        let cfg = &self.cfg;
+        let n_bodies = self.n_bodies;
+        let mut fl = 0u32;
+        let motion_ok: Vec<bool> = (0..n_bodies)
+            .map(|b| self.arrival[b].is_some_and(|a| clock_s - a <= cfg.max_motion_age_s))
+            .collect();
+        if self.arrival.iter().any(|a| a.is_none()) {
+            fl |= flags::NO_MOTION;
+        }
+        if motion_ok.iter().any(|ok| !ok) {
+            fl |= flags::STALE_MOTION;
+        }
+        let t0 = self
+            .hist
+            .iter()
+            .filter_map(|h| h.newest_time_s())
+            .fold(f64::INFINITY, f64::min);
+        match self.field.as_ref().map(|f| t0 - f.time_s) {
+            None => fl |= flags::NO_WAVES,
+            Some(a) if a.is_nan() || a > cfg.suppress_wave_age_s => fl |= flags::NO_WAVES | flags::STALE_WAVES,
+            Some(a) if a > cfg.max_wave_age_s => fl |= flags::STALE_WAVES,
+            _ => {}
+        }
+        let can = fl & (flags::NO_WAVES | flags::NO_MOTION | flags::STALE_MOTION) == 0 && t0.is_finite();
+        let mut job = None;
+        if can && self.busy {
+            self.counters.overruns += 1;
+        } else if can && let Some(f) = &self.field {
+            let dt = cfg.dt_s;
+            let n_hist = self.taps.saturating_sub(1);
+            let mut x0 = vec![0.0; self.n_active];
+            let mut v0 = vec![0.0; self.n_active];
+            let mut velocities = vec![vec![0.0; self.n_active]; n_hist];
+            let mut ok = true;
+            for b in 0..n_bodies {
+                let Some(r) = self.hist[b].resample(t0, dt, n_hist, cfg.max_gap_s) else {
+                    ok = false;
+                    break;
+                };
+                if r.short {
+                    fl |= flags::HISTORY_SHORT;
+                }
+                if r.gap {
+                    fl |= flags::HISTORY_GAP;
+                }
+                for (row, &i) in self.active.iter().enumerate() {
+                    if i / 6 == b && i < 6 * n_bodies {
+                        x0[row] = r.x0[i % 6];
+                        v0[row] = r.v0[i % 6];
+                        for (m, v) in r.velocities.iter().enumerate() {
+                            velocities[m][row] = v[i % 6];
+                        }
+                    }
+                }
+            }
+            if ok {
+                let mut header = ForecastHeader {
+                    schema_version: SCHEMA_VERSION,
+                    n_vessels: n_bodies as u32,
+                    dt_s: dt,
+                    n_series: (6 * n_bodies) as u32,
+                    flags: fl,
+                    wave_time_s: f.time_s,
+                    motion_time_s: t0,
+                    ..ForecastHeader::default()
+                };
+                for (b, p) in self.positions.iter().enumerate() {
+                    let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0);
+                    header.horizon_s[b] = (h.horizon_s - (t0 - f.time_s)).max(0.0);
+                }
+                let waves = f.for_vessel(self.origin_m, self.heading, t0);
+                self.busy = true;
+                job = Some(Job {
+                    t0_s: t0,
+                    x0,
+                    v0,
+                    velocities,
+                    waves,
+                    header,
+                });
+            }
+        }
+        self.state_flags = fl | (self.state_flags & flags::NUMERICAL);
+        job
+    }
+
+    /// A finished job: the forecast to publish, if it succeeded.
+    pub fn done(&mut self, d: Done) -> Option<Output> {
+        self.busy = false;
+        self.last_compute_ms = d.compute_ms;
+        match (d.values, d.error) {
+            (Some(values), _) => {
+                self.counters.forecasts += 1;
+                self.last_forecast_time = d.header.issue_time_s;
+                self.last_horizon = d.header.horizon_s;
+                Some(Output::Forecast(d.header, values))
+            }
+            (None, e) => {
+                self.state_flags |= flags::NUMERICAL;
+                tracing::warn!("forecast abandoned: {}", e.unwrap_or_default());
+                None
+            }
+        }
+    }
+
+    /// The status at `clock_s` (`wall_s`: the wall clock to stamp it with); clears the one-shot flags.
+    pub fn status(&mut self, clock_s: f64, wall_s: f64, running: bool) -> Status {
+        let c = &self.counters;
+        let now_data = self
+            .hist
+            .iter()
+            .filter_map(|h| h.newest_time_s())
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mut s = Status {
+            schema_version: SCHEMA_VERSION,
+            flags: self.state_flags,
+            time_s: if now_data.is_finite() { now_data } else { -1.0 },
+            wall_time_s: wall_s,
+            wave_age_s: match &self.field {
+                Some(f) if now_data.is_finite() => now_data - f.time_s,
+                _ => -1.0,
+            },
+            last_forecast_time_s: self.last_forecast_time,
+            last_compute_ms: self.last_compute_ms,
+            horizon_s: self.last_horizon,
+            forecasts: c.forecasts,
+            overruns: c.overruns,
+            samples: c.samples,
+            wave_fields: c.wave_fields,
+            dropped_nonfinite: c.nonfinite,
+            dropped_late: c.late,
+            dropped_duplicate: c.duplicate,
+            running: running as u32,
+            ..Status::default()
+        };
+        for (b, h) in self.hist.iter().enumerate() {
+            s.motion_age_s[b] = self.arrival[b].map(|a| clock_s - a).unwrap_or(-1.0);
+            s.motion_rate_hz[b] = h.rate_hz();
+        }
+        self.state_flags &= !flags::NUMERICAL;
+        s
+    }
+}
+
+/// Runs the daemon until SIGINT/SIGTERM.
 pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) -> Result<(), Error> {
     let n_bodies = sys.spec.bodies.len();
     if n_bodies > MAX_VESSELS {
@@ -160,21 +433,14 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     }
     let t_build = Instant::now();
     let model = TimeModel::new(&sys, rom_options(&cfg))?;
-    let taps = match &model.kernel {
-        crate::rom::model::Kernel::Convolution { taps, .. } => *taps,
-        crate::rom::model::Kernel::StateSpace { .. } => {
-            (cfg.forecast.memory_s.unwrap_or(120.0) / cfg.forecast.dt_s).round() as usize
-        }
-    };
-    let memory_s = taps as f64 * cfg.forecast.dt_s;
+    let mut engine = Engine::new(&cfg, &sys, &model);
     tracing::info!(
         vessels = n_bodies,
         active_dofs = model.n(),
-        memory_s,
+        memory_s = engine.memory_s(),
         build_s = t_build.elapsed().as_secs_f64(),
         "model ready"
     );
-    let (positions, heading) = vessel_positions(&cfg, &sys);
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
     };
@@ -190,19 +456,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     }
     let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
     let (done_tx, mut done_rx) = tokio::sync::mpsc::channel::<Done>(4);
-    let active = model.active.clone();
-    let n_active = model.n();
-    let compute = compute_thread(model, n_bodies, cfg.forecast.horizon_s, job_rx, done_tx);
-    let keep_s = memory_s + cfg.forecast.history_margin_s;
-    let mut hist: Vec<History> = (0..n_bodies).map(|_| History::new(keep_s)).collect();
-    let mut arrival: Vec<Option<Instant>> = vec![None; n_bodies];
-    let mut field: Option<WaveField> = None;
-    let mut c = Counters::default();
-    let mut busy = false;
-    let mut last_forecast_time = -1.0;
-    let mut last_compute_ms = 0.0;
-    let mut last_horizon = [0.0; MAX_VESSELS];
-    let mut state_flags = 0u32;
+    let compute = compute_thread(Computer::new(model, n_bodies, cfg.forecast.horizon_s), job_rx, done_tx);
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     let mut watchdog_usec = 0u64;
     let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
@@ -210,191 +464,36 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let mut sigterm = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
-    let dt = cfg.forecast.dt_s;
-    let status = |flags_now: u32,
-                  hist: &[History],
-                  arrival: &[Option<Instant>],
-                  field: &Option<WaveField>,
-                  c: &Counters,
-                  last_forecast_time: f64,
-                  last_compute_ms: f64,
-                  last_horizon: [f64; MAX_VESSELS],
-                  running: bool|
-     -> Status {
-        let now_data = hist
-            .iter()
-            .filter_map(|h| h.newest_time_s())
-            .fold(f64::NEG_INFINITY, f64::max);
-        let mut s = Status {
-            schema_version: SCHEMA_VERSION,
-            flags: flags_now,
-            time_s: if now_data.is_finite() { now_data } else { -1.0 },
-            wall_time_s: wall_s(),
-            wave_age_s: match field {
-                Some(f) if now_data.is_finite() => now_data - f.time_s,
-                _ => -1.0,
-            },
-            last_forecast_time_s: last_forecast_time,
-            last_compute_ms,
-            horizon_s: last_horizon,
-            forecasts: c.forecasts,
-            overruns: c.overruns,
-            samples: c.samples,
-            wave_fields: c.wave_fields,
-            dropped_nonfinite: c.nonfinite,
-            dropped_late: c.late,
-            dropped_duplicate: c.duplicate,
-            running: running as u32,
-            ..Status::default()
-        };
-        for (b, h) in hist.iter().enumerate() {
-            s.motion_age_s[b] = arrival[b].map(|a| a.elapsed().as_secs_f64()).unwrap_or(-1.0);
-            s.motion_rate_hz[b] = h.rate_hz();
-        }
-        s
-    };
+    let start = Instant::now();
+    let clock = || start.elapsed().as_secs_f64();
     loop {
         tokio::select! {
             _ = tokio::signal::ctrl_c() => { tracing::info!("SIGINT: stopping"); break; }
             _ = sigterm.recv() => { tracing::info!("SIGTERM: stopping"); break; }
             msg = in_rx.recv() => {
                 let Some(msg) = msg else { break };
-                match msg {
-                    Input::Motion(m) => {
-                        c.samples += 1;
-                        let b = m.vessel as usize;
-                        if m.schema_version != SCHEMA_VERSION || b >= n_bodies {
-                            c.rejected += 1;
-                            continue;
-                        }
-                        match hist[b].push(Sample { time_s: m.time_s, x: m.x, v: m.v }) {
-                            Ok(()) => arrival[b] = Some(Instant::now()),
-                            Err(Drop::NonFinite) => c.nonfinite += 1,
-                            Err(Drop::Late) => c.late += 1,
-                            Err(Drop::Duplicate) => c.duplicate += 1,
-                        }
-                    }
-                    Input::Waves(f) => {
-                        c.wave_fields += 1;
-                        let f = f.pruned(cfg.forecast.wave_variance_kept);
-                        if field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
-                            field = Some(f);
-                        }
-                    }
-                    Input::Rejected(why) => {
-                        c.rejected += 1;
-                        tracing::warn!("input rejected: {why}");
-                    }
-                }
+                engine.input(msg, clock());
             }
             done = done_rx.recv() => {
                 let Some(d) = done else { break };
-                busy = false;
-                last_compute_ms = d.compute_ms;
-                match (d.values, d.error) {
-                    (Some(values), _) => {
-                        c.forecasts += 1;
-                        last_forecast_time = d.header.issue_time_s;
-                        last_horizon = d.header.horizon_s;
-                        let _ = out_tx.send(Output::Forecast(d.header, values));
-                    }
-                    (None, e) => {
-                        state_flags |= flags::NUMERICAL;
-                        tracing::warn!("forecast abandoned: {}", e.unwrap_or_default());
-                    }
+                if let Some(out) = engine.done(d) {
+                    let _ = out_tx.send(out);
                 }
             }
             _ = tick.tick() => {
                 if watchdog {
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
-                let mut fl = 0u32;
-                // inputs
-                let motion_ok: Vec<bool> = (0..n_bodies)
-                    .map(|b| arrival[b].is_some_and(|a| a.elapsed().as_secs_f64() <= cfg.forecast.max_motion_age_s))
-                    .collect();
-                if arrival.iter().any(|a| a.is_none()) {
-                    fl |= flags::NO_MOTION;
+                if let Some(job) = engine.tick(clock()) {
+                    let _ = job_tx.send(job);
                 }
-                if motion_ok.iter().any(|ok| !ok) {
-                    fl |= flags::STALE_MOTION;
-                }
-                let t0 = hist.iter().filter_map(|h| h.newest_time_s()).fold(f64::INFINITY, f64::min);
-                let wave_age = field.as_ref().map(|f| t0 - f.time_s);
-                match wave_age {
-                    None => fl |= flags::NO_WAVES,
-                    Some(a) if a.is_nan() || a > cfg.forecast.suppress_wave_age_s => fl |= flags::NO_WAVES | flags::STALE_WAVES,
-                    Some(a) if a > cfg.forecast.max_wave_age_s => fl |= flags::STALE_WAVES,
-                    _ => {}
-                }
-                let can = fl & (flags::NO_WAVES | flags::NO_MOTION | flags::STALE_MOTION) == 0 && t0.is_finite();
-                if can && busy {
-                    c.overruns += 1;
-                } else if can {
-                    // build the job from the histories at t0
-                    let mut x0 = vec![0.0; n_active];
-                    let mut v0 = vec![0.0; n_active];
-                    let mut velocities = vec![vec![0.0; n_active]; taps.saturating_sub(1)];
-                    let mut ok = true;
-                    for b in 0..n_bodies {
-                        let Some(r) = hist[b].resample(t0, dt, taps.saturating_sub(1), cfg.forecast.max_gap_s) else {
-                            ok = false;
-                            break;
-                        };
-                        if r.short { fl |= flags::HISTORY_SHORT; }
-                        if r.gap { fl |= flags::HISTORY_GAP; }
-                        for (row, &i) in active.iter().enumerate() {
-                            if i / 6 == b && i < 6 * n_bodies {
-                                x0[row] = r.x0[i % 6];
-                                v0[row] = r.v0[i % 6];
-                                for (m, v) in r.velocities.iter().enumerate() {
-                                    velocities[m][row] = v[i % 6];
-                                }
-                            }
-                        }
-                    }
-                    if let (true, Some(f)) = (ok, &field) {
-                        let mut header = ForecastHeader {
-                            schema_version: SCHEMA_VERSION,
-                            n_vessels: n_bodies as u32,
-                            dt_s: dt,
-                            n_series: (6 * n_bodies) as u32,
-                            flags: fl,
-                            wave_time_s: f.time_s,
-                            motion_time_s: t0,
-                            ..ForecastHeader::default()
-                        };
-                        for (b, p) in positions.iter().enumerate() {
-                            let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0);
-                            header.horizon_s[b] = (h.horizon_s - (t0 - f.time_s)).max(0.0);
-                        }
-                        let waves = f.for_vessel(positions_origin(&cfg), heading, t0);
-                        if job_tx.send(Job { t0_s: t0, x0, v0, velocities, waves, header }).is_ok() {
-                            busy = true;
-                        }
-                    }
-                }
-                state_flags = fl | (state_flags & flags::NUMERICAL);
-                let _ = out_tx.send(Output::Status(status(
-                    state_flags, &hist, &arrival, &field, &c, last_forecast_time, last_compute_ms, last_horizon, true,
-                )));
-                state_flags &= !flags::NUMERICAL;
+                let _ = out_tx.send(Output::Status(engine.status(clock(), wall_s(), true)));
             }
         }
     }
     // clean shutdown: the last status says so, then the ports go
     stop.store(true, Ordering::Relaxed);
-    let _ = out_tx.send(Output::Status(status(
-        state_flags,
-        &hist,
-        &arrival,
-        &field,
-        &c,
-        last_forecast_time,
-        last_compute_ms,
-        last_horizon,
-        false,
-    )));
+    let _ = out_tx.send(Output::Status(engine.status(clock(), wall_s(), false)));
     drop(out_tx);
     drop(job_tx);
     drop(in_rx);
@@ -402,19 +501,14 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let _ = output.join();
     let _ = input.join();
     let _ = compute.join();
+    let c = &engine.counters;
     tracing::info!(
         forecasts = c.forecasts,
         overruns = c.overruns,
         samples = c.samples,
         "shipcast stopped"
     );
-    let _ = wire::SCHEMA_VERSION;
     Ok(())
-}
-
-/// The system's origin in the earth frame.
-fn positions_origin(cfg: &ShipcastConfig) -> [f64; 2] {
-    [cfg.site.origin_east_m, cfg.site.origin_north_m]
 }
 
 /// A motion sample on the wire from the simulator's.

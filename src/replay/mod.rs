@@ -1,0 +1,317 @@
+//! Recorded logs (shell): MCAP files of JSON messages, and replay through the daemon's own engine.
+//!
+//! Why MCAP: chunked, indexed, compressed (zstd), self-describing (each channel names its schema), with
+//! off-the-shelf readers in Python, C++, Go, TypeScript (`pip install mcap`, Foxglove); a file cut short
+//! is readable up to its last complete chunk. Messages are JSON (encoding `json`, JSON-schema schemas) so
+//! any tool can read them without shipcast; numbers are written with shortest round-trip formatting, so
+//! a replay sees bit-for-bit the values that were recorded. Log time = the data clock in nanoseconds.
+//!
+//! Channels (each with channel metadata `shipcast_schema_version`):
+//! - `/motion`: `{"vessel", "time_s", "x": [6], "v": [6]}` (measured; body-frame surge..yaw, m and rad)
+//! - `/waves`: `{"time_s", "ref_east_m", "ref_north_m", "radius_m", "depth_m", "g_m_s2",
+//!   "components": [[omega_rad_s, direction_rad, re_m, im_m], ...]}` (earth frame, as on the wire)
+//! - `/truth`: like `/motion`, the simulator's true motion (absent from real logs)
+//! - `/forecast`: `{"issue_time_s", "dt_s", "steps", "flags", "wave_time_s", "motion_time_s",
+//!   "compute_ms", "horizon_s": [..], "values": [...]}` (series-major as on the wire)
+
+use crate::ipc::wire::{ForecastHeader, MotionSample, SCHEMA_VERSION};
+use crate::waves::field::{FieldComponent, Region, WaveField};
+use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MotionRecord {
+    pub vessel: u32,
+    pub time_s: f64,
+    pub x: [f64; 6],
+    pub v: [f64; 6],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WavesRecord {
+    pub time_s: f64,
+    pub ref_east_m: f64,
+    pub ref_north_m: f64,
+    pub radius_m: f64,
+    pub depth_m: f64,
+    pub g_m_s2: f64,
+    pub components: Vec<[f64; 4]>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ForecastRecord {
+    pub issue_time_s: f64,
+    pub dt_s: f64,
+    pub steps: u32,
+    pub flags: u32,
+    pub wave_time_s: f64,
+    pub motion_time_s: f64,
+    pub compute_ms: f64,
+    pub horizon_s: Vec<f64>,
+    pub values: Vec<f64>,
+}
+
+impl MotionRecord {
+    pub fn to_wire(&self) -> MotionSample {
+        MotionSample {
+            schema_version: SCHEMA_VERSION,
+            vessel: self.vessel,
+            time_s: self.time_s,
+            x: self.x,
+            v: self.v,
+        }
+    }
+}
+
+impl WavesRecord {
+    pub fn of(f: &WaveField) -> WavesRecord {
+        WavesRecord {
+            time_s: f.time_s,
+            ref_east_m: f.reference_m[0],
+            ref_north_m: f.reference_m[1],
+            radius_m: match f.region {
+                Region::Disc { radius_m, .. } => radius_m,
+                _ => 0.0,
+            },
+            depth_m: f.depth_m.unwrap_or(0.0),
+            g_m_s2: f.g_m_s2,
+            components: f
+                .components
+                .iter()
+                .map(|c| [c.omega_rad_s, c.direction_rad, c.amplitude_m.re, c.amplitude_m.im])
+                .collect(),
+        }
+    }
+
+    pub fn field(&self) -> Result<WaveField, String> {
+        let f = WaveField {
+            components: self
+                .components
+                .iter()
+                .map(|c| FieldComponent {
+                    omega_rad_s: c[0],
+                    direction_rad: c[1],
+                    amplitude_m: Complex64::new(c[2], c[3]),
+                })
+                .collect(),
+            reference_m: [self.ref_east_m, self.ref_north_m],
+            time_s: self.time_s,
+            g_m_s2: self.g_m_s2,
+            depth_m: (self.depth_m > 0.0).then_some(self.depth_m),
+            region: if self.radius_m > 0.0 {
+                Region::Disc {
+                    centre_m: [self.ref_east_m, self.ref_north_m],
+                    radius_m: self.radius_m,
+                }
+            } else {
+                Region::Everywhere
+            },
+        };
+        f.validate().map_err(|e| e.to_string())?;
+        Ok(f)
+    }
+}
+
+impl ForecastRecord {
+    pub fn of(h: &ForecastHeader, values: &[f64]) -> ForecastRecord {
+        ForecastRecord {
+            issue_time_s: h.issue_time_s,
+            dt_s: h.dt_s,
+            steps: h.steps,
+            flags: h.flags,
+            wave_time_s: h.wave_time_s,
+            motion_time_s: h.motion_time_s,
+            compute_ms: h.compute_ms,
+            horizon_s: h.horizon_s[..h.n_vessels as usize].to_vec(),
+            values: values.to_vec(),
+        }
+    }
+}
+
+/// A log being written.
+pub struct Recorder<W: Write + Seek> {
+    w: mcap::Writer<W>,
+    channels: BTreeMap<&'static str, u16>,
+    seq: u32,
+}
+
+pub type Error = Box<dyn std::error::Error + Send + Sync>;
+
+const TOPICS: [(&str, &str); 4] = [
+    ("/motion", "shipcast.Motion"),
+    ("/waves", "shipcast.Waves"),
+    ("/truth", "shipcast.Motion"),
+    ("/forecast", "shipcast.Forecast"),
+];
+
+impl Recorder<BufWriter<std::fs::File>> {
+    pub fn create(path: &Path) -> Result<Self, Error> {
+        let f = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Recorder::new(BufWriter::new(f))
+    }
+}
+
+impl<W: Write + Seek> Recorder<W> {
+    pub fn new(w: W) -> Result<Self, Error> {
+        let mut w = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .chunk_size(Some(1 << 20))
+            .profile("shipcast")
+            .create(w)?;
+        let mut channels = BTreeMap::new();
+        let mut meta = BTreeMap::new();
+        meta.insert("shipcast_schema_version".to_string(), SCHEMA_VERSION.to_string());
+        for (topic, schema) in TOPICS {
+            let sid = w.add_schema(schema, "jsonschema", br#"{"type":"object"}"#)?;
+            channels.insert(topic, w.add_channel(sid, topic, "json", &meta)?);
+        }
+        Ok(Recorder { w, channels, seq: 0 })
+    }
+
+    pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
+        let id = *self
+            .channels
+            .get(topic)
+            .ok_or_else(|| format!("unknown topic {topic}"))?;
+        let data = serde_json::to_vec(msg)?;
+        let t = (time_s.max(0.0) * 1e9) as u64;
+        self.seq += 1;
+        self.w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: self.seq,
+                log_time: t,
+                publish_time: t,
+            },
+            &data,
+        )?;
+        Ok(())
+    }
+
+    pub fn finish(mut self) -> Result<(), Error> {
+        self.w.finish()?;
+        Ok(())
+    }
+}
+
+/// What a log holds, in log-time order.
+#[derive(Debug, Clone)]
+pub enum Record {
+    Motion(MotionRecord),
+    Waves(WavesRecord),
+    Truth(MotionRecord),
+    Forecast(ForecastRecord),
+}
+
+/// A log read as far as it can be: the records, and a warning when it stopped early (truncated or
+/// corrupt) or skipped messages.
+pub struct Read {
+    pub records: Vec<(f64, Record)>,
+    pub warnings: Vec<String>,
+}
+
+/// Reads a log. A newer schema version is an error; a truncated or corrupt tail keeps every message
+/// before it (with a warning); an undecodable message is skipped (counted in a warning).
+pub fn read(path: &Path) -> Result<Read, Error> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = Read {
+        records: vec![],
+        warnings: vec![],
+    };
+    let stream = mcap::MessageStream::new_with_options(&bytes, mcap::read::Options::IgnoreEndMagic.into())
+        .map_err(|e| format!("{}: not an MCAP log: {e}", path.display()))?;
+    let mut skipped = 0usize;
+    for m in stream {
+        let m = match m {
+            Ok(m) => m,
+            Err(e) => {
+                out.warnings.push(format!(
+                    "{}: the log stops being readable after {} messages ({e}): using what came before",
+                    path.display(),
+                    out.records.len()
+                ));
+                break;
+            }
+        };
+        if let Some(v) = m.channel.metadata.get("shipcast_schema_version") {
+            let v: u32 = v.parse().unwrap_or(u32::MAX);
+            if v > SCHEMA_VERSION {
+                return Err(format!(
+                    "{}: channel {} is schema version {v}; this shipcast reads up to {SCHEMA_VERSION}: upgrade shipcast",
+                    path.display(),
+                    m.channel.topic
+                )
+                .into());
+            }
+        }
+        let t = m.log_time as f64 * 1e-9;
+        let rec = match m.channel.topic.as_str() {
+            "/motion" => serde_json::from_slice(&m.data).map(Record::Motion),
+            "/truth" => serde_json::from_slice(&m.data).map(Record::Truth),
+            "/waves" => serde_json::from_slice(&m.data).map(Record::Waves),
+            "/forecast" => serde_json::from_slice(&m.data).map(Record::Forecast),
+            _ => continue,
+        };
+        match rec {
+            Ok(r) => out.records.push((t, r)),
+            Err(_) => skipped += 1,
+        }
+    }
+    if skipped > 0 {
+        out.warnings.push(format!(
+            "{}: {skipped} messages could not be decoded and were skipped",
+            path.display()
+        ));
+    }
+    Ok(out)
+}
+
+/// Feeds a log's inputs through the daemon's engine and computer on the log's clock: ticks every
+/// `period_s` of log time, forecasts computed inline (no overruns: replay is not real time).
+/// `on_forecast` sees every forecast; `pace` is called with each tick's log time (the shell sleeps
+/// there for `--speed`).
+pub fn drive(
+    cfg: &crate::service::config::ShipcastConfig,
+    sys: &crate::hydro::VesselSystem,
+    records: &[(f64, Record)],
+    mut pace: impl FnMut(f64),
+    mut on_forecast: impl FnMut(&ForecastHeader, &[f64]),
+) -> Result<crate::service::Counters, Error> {
+    use crate::ipc::{Input, Output};
+    use crate::service::{Computer, Engine, rom_options};
+    let model = crate::rom::TimeModel::new(sys, rom_options(cfg))?;
+    let mut engine = Engine::new(cfg, sys, &model);
+    let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg.forecast.horizon_s);
+    let period = cfg.forecast.period_s;
+    let mut next_tick: Option<f64> = None;
+    let mut tick_until = |t: f64, engine: &mut Engine, computer: &mut Computer, next: &mut Option<f64>| {
+        let mut nt = next.unwrap_or(t);
+        while nt <= t {
+            pace(nt);
+            if let Some(job) = engine.tick(nt) {
+                let d = computer.run(job, || 0.0);
+                if let Some(Output::Forecast(h, v)) = engine.done(d) {
+                    on_forecast(&h, &v);
+                }
+            }
+            let _ = engine.status(nt, nt, true);
+            nt += period;
+        }
+        *next = Some(nt);
+    };
+    for (t, r) in records {
+        tick_until(*t, &mut engine, &mut computer, &mut next_tick);
+        match r {
+            Record::Motion(m) => engine.input(Input::Motion(m.to_wire()), *t),
+            Record::Waves(w) => match w.field() {
+                Ok(f) => engine.input(Input::Waves(f), *t),
+                Err(e) => engine.input(Input::Rejected(e), *t),
+            },
+            Record::Truth(_) | Record::Forecast(_) => {}
+        }
+    }
+    Ok(engine.counters.clone())
+}

@@ -1,0 +1,146 @@
+//! Forecast skill against what happened (pure): per series (vessel DOF or point) and lead time, the
+//! correlation, the normalized RMS error (RMS error / standard deviation of the measurement), the
+//! surface similarity parameter SSP = |f - m| / (|f| + |m|) (0 perfect, 1 no skill) and the bias
+//! (mean of f - m). Leads are the forecast's own steps, binned to `lead_step_s`.
+//!
+//! Inputs: forecasts as (issue time t0, dt, values at t0 + k dt) and the measured series as samples
+//! (time, value) sorted by time; the measurement is interpolated linearly at each valid time and pairs
+//! without a measurement on both sides are skipped.
+
+/// One forecast of one series.
+#[derive(Debug, Clone, Copy)]
+pub struct SeriesForecast<'a> {
+    pub t0_s: f64,
+    pub dt_s: f64,
+    pub values: &'a [f64],
+}
+
+/// Skill of one series against lead time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skill {
+    pub lead_s: Vec<f64>,
+    pub correlation: Vec<f64>,
+    pub nrmse: Vec<f64>,
+    pub ssp: Vec<f64>,
+    pub bias: Vec<f64>,
+    /// Pairs behind each lead.
+    pub count: Vec<usize>,
+}
+
+/// Linear interpolation in a sorted (time, value) series; None outside it.
+pub fn interpolate(measured: &[(f64, f64)], t: f64) -> Option<f64> {
+    let i = measured.partition_point(|(tm, _)| *tm <= t);
+    if i == 0 || i >= measured.len() {
+        return None;
+    }
+    let (t0, x0) = measured[i - 1];
+    let (t1, x1) = measured[i];
+    if t1 <= t0 {
+        return Some(x0);
+    }
+    Some(x0 + (x1 - x0) * (t - t0) / (t1 - t0))
+}
+
+/// Skill at leads 0, step, 2 step, ... up to `max_lead_s`.
+pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s: f64, max_lead_s: f64) -> Skill {
+    let nl = (max_lead_s / lead_step_s).floor() as usize + 1;
+    let mut pairs: Vec<Vec<(f64, f64)>> = vec![vec![]; nl];
+    for f in forecasts {
+        for (l, p) in pairs.iter_mut().enumerate() {
+            let lead = l as f64 * lead_step_s;
+            let k = (lead / f.dt_s).round() as usize;
+            let (Some(v), Some(m)) = (f.values.get(k), interpolate(measured, f.t0_s + k as f64 * f.dt_s)) else {
+                continue;
+            };
+            if v.is_finite() && m.is_finite() {
+                p.push((*v, m));
+            }
+        }
+    }
+    let mut s = Skill {
+        lead_s: (0..nl).map(|l| l as f64 * lead_step_s).collect(),
+        correlation: vec![],
+        nrmse: vec![],
+        ssp: vec![],
+        bias: vec![],
+        count: vec![],
+    };
+    for p in &pairs {
+        let n = p.len() as f64;
+        s.count.push(p.len());
+        if p.len() < 2 {
+            for v in [&mut s.correlation, &mut s.nrmse, &mut s.ssp, &mut s.bias] {
+                v.push(f64::NAN);
+            }
+            continue;
+        }
+        let mf = p.iter().map(|q| q.0).sum::<f64>() / n;
+        let mm = p.iter().map(|q| q.1).sum::<f64>() / n;
+        let (mut sfm, mut sff, mut smm, mut e2, mut f2, mut m2) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for (f, m) in p {
+            sfm += (f - mf) * (m - mm);
+            sff += (f - mf) * (f - mf);
+            smm += (m - mm) * (m - mm);
+            e2 += (f - m) * (f - m);
+            f2 += f * f;
+            m2 += m * m;
+        }
+        s.correlation.push(sfm / (sff * smm).sqrt());
+        s.nrmse.push((e2 / n).sqrt() / (smm / n).sqrt());
+        s.ssp.push(e2.sqrt() / (f2.sqrt() + m2.sqrt()));
+        s.bias.push(mf - mm);
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_perfect_forecast_scores_perfectly_and_a_delayed_one_loses_skill_with_lead() {
+        let truth = |t: f64| (0.7 * t).sin();
+        let measured: Vec<(f64, f64)> = (0..4000).map(|k| (k as f64 * 0.1, truth(k as f64 * 0.1))).collect();
+        let perfect: Vec<Vec<f64>> = (0..20)
+            .map(|j| (0..=300).map(|k| truth(10.0 * j as f64 + k as f64 * 0.1)).collect())
+            .collect();
+        let fs: Vec<SeriesForecast> = perfect
+            .iter()
+            .enumerate()
+            .map(|(j, v)| SeriesForecast {
+                t0_s: 10.0 * j as f64,
+                dt_s: 0.1,
+                values: v,
+            })
+            .collect();
+        let s = score(&fs, &measured, 5.0, 30.0);
+        assert_eq!(s.lead_s.len(), 7);
+        for l in 0..7 {
+            assert!((s.correlation[l] - 1.0).abs() < 1e-4, "{:?}", s.correlation);
+            assert!(s.nrmse[l] < 1e-2 && s.ssp[l] < 1e-2 && s.bias[l].abs() < 1e-2);
+        }
+        // a forecast whose phase drifts with lead (wrong frequency): correlation falls
+        let drift: Vec<Vec<f64>> = (0..20)
+            .map(|j| {
+                (0..=300)
+                    .map(|k| {
+                        let t = 10.0 * j as f64 + k as f64 * 0.1;
+                        (0.7 * t + 0.05 * k as f64 * 0.1).sin()
+                    })
+                    .collect()
+            })
+            .collect();
+        let fs: Vec<SeriesForecast> = drift
+            .iter()
+            .enumerate()
+            .map(|(j, v)| SeriesForecast {
+                t0_s: 10.0 * j as f64,
+                dt_s: 0.1,
+                values: v,
+            })
+            .collect();
+        let s = score(&fs, &measured, 5.0, 30.0);
+        assert!(s.correlation[0] > 0.999 && s.correlation[6] < s.correlation[1]);
+        assert!(s.nrmse[6] > s.nrmse[1]);
+    }
+}
