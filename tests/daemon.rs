@@ -453,3 +453,68 @@ fn a_python_console_decodes_a_live_forecast() {
     }
     eprintln!("python decoded: {}", lines[0]);
 }
+
+#[test]
+fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
+    use shipcast::replay::{Record, read};
+    let dir = crate::util::scratch_dir("daemon-record");
+    let rec_dir = dir.join("logs");
+    let cfg = config(&dir, "record", &format!("[record]\ndir = \"{}\"\n", rec_dir.display()));
+    {
+        let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+        std::thread::sleep(Duration::from_millis(1500));
+        let _sim = spawn(&[
+            "simulate",
+            "--publish",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--duration",
+            "120",
+        ]);
+        std::thread::sleep(Duration::from_secs(25));
+    } // SIGINT to both: the daemon closes its log
+    let logs: Vec<PathBuf> = std::fs::read_dir(&rec_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
+        .collect();
+    assert_eq!(logs.len(), 1, "{logs:?}");
+    let live: Vec<_> = read(&logs[0])
+        .unwrap()
+        .records
+        .into_iter()
+        .filter_map(|(_, r)| match r {
+            Record::Forecast(f) => Some(f),
+            _ => None,
+        })
+        .collect();
+    let out = dir.join("replayed.mcap");
+    let (ok, _, err) = crate::util::shipcast(&[
+        "replay",
+        logs[0].to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "--max",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let replayed: Vec<_> = read(&out)
+        .unwrap()
+        .records
+        .into_iter()
+        .filter_map(|(_, r)| match r {
+            Record::Forecast(f) => Some(f),
+            _ => None,
+        })
+        .collect();
+    eprintln!("{} live forecasts, {} replayed", live.len(), replayed.len());
+    assert!(live.len() >= 10);
+    assert_eq!(live.len(), replayed.len());
+    for (a, b) in live.iter().zip(&replayed) {
+        assert_eq!(a.issue_time_s.to_bits(), b.issue_time_s.to_bits());
+        assert_eq!(a.flags, b.flags);
+        assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
+        assert_eq!(a.values.len(), b.values.len());
+    }
+}

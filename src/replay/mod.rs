@@ -136,16 +136,89 @@ pub struct Recorder<W: Write + Seek> {
     w: mcap::Writer<W>,
     channels: BTreeMap<&'static str, u16>,
     seq: u32,
+    /// Message bytes written so far (before compression).
+    pub bytes: u64,
+}
+
+/// The daemon's recording: `shipcast-<n>.mcap` files in a directory, a new one past a size.
+pub struct RotatingRecorder {
+    dir: std::path::PathBuf,
+    rotate_bytes: u64,
+    index: u32,
+    current: Option<Recorder<BufWriter<std::fs::File>>>,
+}
+
+impl RotatingRecorder {
+    pub fn new(dir: &Path, rotate_mb: f64) -> Result<Self, Error> {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_secs())
+            .unwrap_or(0);
+        let mut r = RotatingRecorder {
+            dir: dir.join(format!("shipcast-{stamp}")),
+            rotate_bytes: (rotate_mb * 1e6) as u64,
+            index: 0,
+            current: None,
+        };
+        r.open()?;
+        Ok(r)
+    }
+
+    fn open(&mut self) -> Result<(), Error> {
+        let p = std::path::PathBuf::from(format!("{}-{:04}.mcap", self.dir.display(), self.index));
+        self.current = Some(Recorder::create(&p)?);
+        self.index += 1;
+        Ok(())
+    }
+
+    pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
+        if self.current.as_ref().is_some_and(|c| c.bytes > self.rotate_bytes)
+            && let Some(c) = self.current.take()
+        {
+            c.finish()?;
+            self.open()?;
+        }
+        match self.current.as_mut() {
+            Some(c) => c.write(topic, time_s, msg),
+            None => Ok(()),
+        }
+    }
+
+    /// Writes a record on its channel.
+    pub fn record(&mut self, t: f64, r: &Record) -> Result<(), Error> {
+        match r {
+            Record::Motion(m) => self.write("/motion", t, m),
+            Record::Waves(w) => self.write("/waves", t, w),
+            Record::Truth(m) => self.write("/truth", t, m),
+            Record::Forecast(f) => self.write("/forecast", t, f),
+            Record::Tick(k) => self.write("/tick", t, k),
+        }
+    }
+
+    pub fn finish(mut self) -> Result<(), Error> {
+        match self.current.take() {
+            Some(c) => c.finish(),
+            None => Ok(()),
+        }
+    }
 }
 
 pub type Error = Box<dyn std::error::Error + Send + Sync>;
 
-const TOPICS: [(&str, &str); 4] = [
+const TOPICS: [(&str, &str); 5] = [
     ("/motion", "shipcast.Motion"),
     ("/waves", "shipcast.Waves"),
     ("/truth", "shipcast.Motion"),
     ("/forecast", "shipcast.Forecast"),
+    ("/tick", "shipcast.Tick"),
 ];
+
+/// A cadence tick of a recording daemon (its engine clock is the log time).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TickRecord {
+    pub clock_s: f64,
+}
 
 impl Recorder<BufWriter<std::fs::File>> {
     pub fn create(path: &Path) -> Result<Self, Error> {
@@ -168,7 +241,12 @@ impl<W: Write + Seek> Recorder<W> {
             let sid = w.add_schema(schema, "jsonschema", br#"{"type":"object"}"#)?;
             channels.insert(topic, w.add_channel(sid, topic, "json", &meta)?);
         }
-        Ok(Recorder { w, channels, seq: 0 })
+        Ok(Recorder {
+            w,
+            channels,
+            seq: 0,
+            bytes: 0,
+        })
     }
 
     pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
@@ -177,6 +255,7 @@ impl<W: Write + Seek> Recorder<W> {
             .get(topic)
             .ok_or_else(|| format!("unknown topic {topic}"))?;
         let data = serde_json::to_vec(msg)?;
+        self.bytes += data.len() as u64;
         let t = (time_s.max(0.0) * 1e9) as u64;
         self.seq += 1;
         self.w.write_to_known_channel(
@@ -204,6 +283,7 @@ pub enum Record {
     Waves(WavesRecord),
     Truth(MotionRecord),
     Forecast(ForecastRecord),
+    Tick(TickRecord),
 }
 
 /// A log read as far as it can be: the records, and a warning when it stopped early (truncated or
@@ -253,6 +333,7 @@ pub fn read(path: &Path) -> Result<Read, Error> {
             "/truth" => serde_json::from_slice(&m.data).map(Record::Truth),
             "/waves" => serde_json::from_slice(&m.data).map(Record::Waves),
             "/forecast" => serde_json::from_slice(&m.data).map(Record::Forecast),
+            "/tick" => serde_json::from_slice(&m.data).map(Record::Tick),
             _ => continue,
         };
         match rec {
@@ -269,8 +350,10 @@ pub fn read(path: &Path) -> Result<Read, Error> {
     Ok(out)
 }
 
-/// Feeds a log's inputs through the daemon's engine and computer on the log's clock: ticks every
-/// `period_s` of log time, forecasts computed inline (no overruns: replay is not real time).
+/// Feeds a log's inputs through the daemon's engine and computer on the log's clock, forecasts computed
+/// inline (no overruns: replay is not real time). A log recorded by the daemon carries its ticks
+/// (`/tick`, log time = the engine's clock): replay ticks exactly there and so takes every decision the
+/// live daemon took; a log without ticks (the simulator's) is ticked every `period_s` of log time.
 /// `on_forecast` sees every forecast; `pace` is called with each tick's log time (the shell sleeps
 /// there for `--speed`).
 pub fn drive(
@@ -287,30 +370,37 @@ pub fn drive(
     let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg.forecast.horizon_s);
     let period = cfg.forecast.period_s;
     let mut next_tick: Option<f64> = None;
-    let mut tick_until = |t: f64, engine: &mut Engine, computer: &mut Computer, next: &mut Option<f64>| {
-        let mut nt = next.unwrap_or(t);
-        while nt <= t {
-            pace(nt);
-            if let Some(job) = engine.tick(nt) {
-                let d = computer.run(job, || 0.0);
-                if let Some(Output::Forecast(h, v)) = engine.done(d) {
-                    on_forecast(&h, &v);
-                }
+    let mut tick = |at: f64, engine: &mut Engine, computer: &mut Computer| {
+        pace(at);
+        if let Some(job) = engine.tick(at) {
+            let d = computer.run(job, || 0.0);
+            if let Some(Output::Forecast(h, v)) = engine.done(d) {
+                on_forecast(&h, &v);
             }
-            let _ = engine.status(nt, nt, true);
-            nt += period;
         }
-        *next = Some(nt);
+        let _ = engine.status(at, at, true);
     };
+    let recorded_ticks = records.iter().any(|(_, r)| matches!(r, Record::Tick(_)));
     for (t, r) in records {
-        tick_until(*t, &mut engine, &mut computer, &mut next_tick);
+        if recorded_ticks {
+            if let Record::Tick(k) = r {
+                tick(k.clock_s, &mut engine, &mut computer);
+            }
+        } else {
+            let mut nt = next_tick.unwrap_or(*t);
+            while nt <= *t {
+                tick(nt, &mut engine, &mut computer);
+                nt += period;
+            }
+            next_tick = Some(nt);
+        }
         match r {
             Record::Motion(m) => engine.input(Input::Motion(m.to_wire()), *t),
             Record::Waves(w) => match w.field() {
                 Ok(f) => engine.input(Input::Waves(f), *t),
                 Err(e) => engine.input(Input::Rejected(e), *t),
             },
-            Record::Truth(_) | Record::Forecast(_) => {}
+            Record::Truth(_) | Record::Forecast(_) | Record::Tick(_) => {}
         }
     }
     Ok(engine.counters.clone())

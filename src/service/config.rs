@@ -18,6 +18,8 @@ pub struct ShipcastConfig {
     #[serde(default)]
     pub log: LogConfig,
     #[serde(default)]
+    pub record: RecordConfig,
+    #[serde(default)]
     pub simulate: SimulateConfig,
     /// Directory of the config file (relative paths are resolved against it); set by [`load`].
     #[serde(skip)]
@@ -109,6 +111,24 @@ impl Default for ForecastConfig {
             max_gap_s: 1.0,
             history_margin_s: 10.0,
             wave_variance_kept: 0.995,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RecordConfig {
+    /// Directory for the daemon's logs (relative to the config file); empty: no recording.
+    pub dir: String,
+    /// A new file once the current one holds this many megabytes (uncompressed message bytes).
+    pub rotate_mb: f64,
+}
+
+impl Default for RecordConfig {
+    fn default() -> Self {
+        RecordConfig {
+            dir: String::new(),
+            rotate_mb: 256.0,
         }
     }
 }
@@ -315,6 +335,12 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     }
     if c.ipc.service_prefix.is_empty() || c.ipc.service_prefix.len() > 200 {
         return Err(("ipc.service_prefix".into(), "must be 1..200 characters".into()));
+    }
+    if !(c.record.rotate_mb.is_finite() && c.record.rotate_mb > 0.0) {
+        return Err((
+            "record.rotate_mb".into(),
+            format!("must be positive, found {}", c.record.rotate_mb),
+        ));
     }
     let s = &c.simulate;
     pos("simulate.duration_s", s.duration_s)?;

@@ -466,17 +466,54 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let mut sigterm = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
     let start = Instant::now();
     let clock = || start.elapsed().as_secs_f64();
+    // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
+    // decision); a write error is logged and ends the recording, never the daemon
+    let mut recorder = if cfg.record.dir.is_empty() {
+        None
+    } else {
+        let dir = cfg.dir.join(&cfg.record.dir);
+        match crate::replay::RotatingRecorder::new(&dir, cfg.record.rotate_mb) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                tracing::error!("recording disabled: {e}");
+                None
+            }
+        }
+    };
+    fn record(recorder: &mut Option<crate::replay::RotatingRecorder>, t: f64, r: crate::replay::Record) {
+        if let Some(rec) = recorder.as_mut()
+            && let Err(e) = rec.record(t, &r)
+        {
+            tracing::error!("recording stopped: {e}");
+            *recorder = None;
+        }
+    }
     loop {
         tokio::select! {
             _ = tokio::signal::ctrl_c() => { tracing::info!("SIGINT: stopping"); break; }
             _ = sigterm.recv() => { tracing::info!("SIGTERM: stopping"); break; }
             msg = in_rx.recv() => {
                 let Some(msg) = msg else { break };
-                engine.input(msg, clock());
+                let t = clock();
+                if recorder.is_some() {
+                    use crate::replay::{MotionRecord, Record, WavesRecord};
+                    match &msg {
+                        Input::Motion(m) => record(&mut recorder, t, Record::Motion(MotionRecord {
+                            vessel: m.vessel, time_s: m.time_s, x: m.x, v: m.v,
+                        })),
+                        Input::Waves(f) => record(&mut recorder, t, Record::Waves(WavesRecord::of(f))),
+                        Input::Rejected(_) => {}
+                    }
+                }
+                engine.input(msg, t);
             }
             done = done_rx.recv() => {
                 let Some(d) = done else { break };
                 if let Some(out) = engine.done(d) {
+                    if let Output::Forecast(h, v) = &out {
+                        let rec = crate::replay::Record::Forecast(crate::replay::ForecastRecord::of(h, v));
+                        record(&mut recorder, clock(), rec);
+                    }
                     let _ = out_tx.send(out);
                 }
             }
@@ -484,7 +521,9 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                 if watchdog {
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
-                if let Some(job) = engine.tick(clock()) {
+                let t = clock();
+                record(&mut recorder, t, crate::replay::Record::Tick(crate::replay::TickRecord { clock_s: t }));
+                if let Some(job) = engine.tick(t) {
                     let _ = job_tx.send(job);
                 }
                 let _ = out_tx.send(Output::Status(engine.status(clock(), wall_s(), true)));
@@ -497,6 +536,11 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     drop(out_tx);
     drop(job_tx);
     drop(in_rx);
+    if let Some(r) = recorder
+        && let Err(e) = r.finish()
+    {
+        tracing::error!("closing the recording: {e}");
+    }
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Stopping]);
     let _ = output.join();
     let _ = input.join();
