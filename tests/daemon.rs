@@ -510,11 +510,16 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         .collect();
     eprintln!("{} live forecasts, {} replayed", live.len(), replayed.len());
     assert!(live.len() >= 10);
-    assert_eq!(live.len(), replayed.len());
-    for (a, b) in live.iter().zip(&replayed) {
-        assert_eq!(a.issue_time_s.to_bits(), b.issue_time_s.to_bits());
+    // every live forecast is replayed identically; replay may have a few more: a tick that overran
+    // live (replay computes inline) and the job still running when the daemon stopped
+    assert!(replayed.len() >= live.len() && replayed.len() <= live.len() + 3);
+    for a in &live {
+        let b = replayed
+            .iter()
+            .find(|b| b.issue_time_s.to_bits() == a.issue_time_s.to_bits())
+            .expect("the live forecast is replayed");
         assert_eq!(a.flags, b.flags);
-        assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
         assert_eq!(a.values.len(), b.values.len());
+        assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 }
