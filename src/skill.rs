@@ -41,6 +41,19 @@ pub fn interpolate(measured: &[(f64, f64)], t: f64) -> Option<f64> {
     Some(x0 + (x1 - x0) * (t - t0) / (t1 - t0))
 }
 
+/// Pearson correlation of two equally long series (NaN when either is constant or empty).
+pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()) as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
 /// Skill at leads 0, step, 2 step, ... up to `max_lead_s`.
 pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s: f64, max_lead_s: f64) -> Skill {
     let nl = (max_lead_s / lead_step_s).floor() as usize + 1;

@@ -145,18 +145,6 @@ fn at(t: &[f64], rows: &[Vec<f64>], time: f64, col: usize) -> Option<f64> {
     Some(rows[i - 1][col] * (1.0 - w) + rows[i][col] * w)
 }
 
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    sab / (saa * sbb).sqrt()
-}
-
 #[test]
 fn forecasts_over_iceoryx2_match_the_simulated_truth() {
     let dir = crate::util::scratch_dir("daemon-e2e");
@@ -204,7 +192,10 @@ fn forecasts_over_iceoryx2_match_the_simulated_truth() {
         tp.push(p_true);
     }
     assert!(fh.len() >= 30, "only {} forecasts to score", fh.len());
-    let (ch, cp) = (correlation(&fh, &th), correlation(&fp, &tp));
+    let (ch, cp) = (
+        shipcast::skill::correlation(&fh, &th),
+        shipcast::skill::correlation(&fp, &tp),
+    );
     eprintln!(
         "{} forecasts, {} scored at {LEAD_S} s lead: heave correlation {ch:.3}, pitch {cp:.3}; horizon reported {} s",
         forecasts.len(),
@@ -479,15 +470,18 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
         .collect();
     assert_eq!(logs.len(), 1, "{logs:?}");
-    let live: Vec<_> = read(&logs[0])
-        .unwrap()
-        .records
-        .into_iter()
-        .filter_map(|(_, r)| match r {
-            Record::Forecast(f) => Some(f),
-            _ => None,
-        })
-        .collect();
+    let forecasts_of = |p: &Path| -> Vec<shipcast::replay::ForecastRecord> {
+        read(p)
+            .unwrap()
+            .records
+            .into_iter()
+            .filter_map(|(_, r)| match r {
+                Record::Forecast(f) => Some(f),
+                _ => None,
+            })
+            .collect()
+    };
+    let live = forecasts_of(&logs[0]);
     let out = dir.join("replayed.mcap");
     let (ok, _, err) = crate::util::shipcast(&[
         "replay",
@@ -499,15 +493,7 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         out.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    let replayed: Vec<_> = read(&out)
-        .unwrap()
-        .records
-        .into_iter()
-        .filter_map(|(_, r)| match r {
-            Record::Forecast(f) => Some(f),
-            _ => None,
-        })
-        .collect();
+    let replayed = forecasts_of(&out);
     eprintln!("{} live forecasts, {} replayed", live.len(), replayed.len());
     assert!(live.len() >= 10);
     // every live forecast is replayed identically; replay may have a few more: a tick that overran
@@ -522,4 +508,42 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         assert_eq!(a.values.len(), b.values.len());
         assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
+}
+
+#[test]
+fn a_killed_daemon_restarts_and_forecasts_again() {
+    use shipcast::ipc::{ForecastSubscriber, Names, Received};
+    let dir = crate::util::scratch_dir("daemon-restart");
+    let cfg = config(&dir, "restart", "");
+    let names = Names {
+        prefix: format!("shipcast-test-{}-restart", std::process::id()),
+    };
+    let mut daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let _sim = spawn(&[
+        "simulate",
+        "--publish",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration",
+        "200",
+    ]);
+    let sub = ForecastSubscriber::new(&names).unwrap();
+    let count_for = |secs: u64| {
+        let mut got = vec![];
+        let t = Instant::now();
+        while t.elapsed() < Duration::from_secs(secs) {
+            sub.wait(Duration::from_millis(300), &mut got).unwrap();
+        }
+        got.iter().filter(|r| matches!(r, Received::Forecast(..))).count()
+    };
+    let before = count_for(5);
+    // SIGKILL: its ports and shared memory are left behind
+    let _ = daemon.0.kill();
+    let _ = daemon.0.wait();
+    std::thread::sleep(Duration::from_secs(1));
+    let _daemon2 = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    let after = count_for(8);
+    eprintln!("forecasts: {before} before the daemon was killed, {after} from the restarted one");
+    assert!(before >= 3 && after >= 3);
 }

@@ -584,7 +584,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
                 let skill = if pairs_f.len() >= 10 {
                     format!(
                         "skill at {LEAD:.0} s so far: correlation {:.3} over {} forecasts",
-                        correlation(&pairs_f, &pairs_m),
+                        shipcast::skill::correlation(&pairs_f, &pairs_m),
                         pairs_f.len()
                     )
                 } else {
@@ -610,16 +610,4 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     }
     println!("shipcast demo: stopping");
     Ok(())
-}
-
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    sab / (saa * sbb).sqrt()
 }
