@@ -90,6 +90,27 @@ fn spawn(args: &[&str]) -> Proc {
     )
 }
 
+/// Starts `shipcast run` on a config and waits until its ports are up.
+fn daemon(cfg: &Path) -> Proc {
+    let d = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(1500));
+    d
+}
+
+/// Starts `shipcast simulate --publish` for `duration_s` (plus any further arguments).
+fn simulator(cfg: &Path, duration_s: &str, more: &[&str]) -> Proc {
+    let mut args = vec![
+        "simulate",
+        "--publish",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration",
+        duration_s,
+    ];
+    args.extend_from_slice(more);
+    spawn(&args)
+}
+
 /// Reads `watch --json` lines until `until` returns true or the time runs out.
 fn watch(cfg: &Path, secs: f64, mut until: impl FnMut(&serde_json::Value) -> bool) -> Vec<serde_json::Value> {
     let mut child = Command::new(bin())
@@ -150,18 +171,8 @@ fn forecasts_over_iceoryx2_match_the_simulated_truth() {
     let dir = crate::util::scratch_dir("daemon-e2e");
     let cfg = config(&dir, "e2e", "");
     let truth_path = dir.join("truth.csv");
-    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-    std::thread::sleep(Duration::from_millis(1500));
-    let _sim = spawn(&[
-        "simulate",
-        "--publish",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--duration",
-        "240",
-        "--truth",
-        truth_path.to_str().unwrap(),
-    ]);
+    let _daemon = daemon(&cfg);
+    let _sim = simulator(&cfg, "240", &["--truth", truth_path.to_str().unwrap()]);
     // 240 s of data at 4x: 60 s of wall time
     let msgs = watch(&cfg, 75.0, |_| false);
     let forecasts: Vec<&serde_json::Value> = msgs.iter().filter(|m| m["kind"] == "forecast").collect();
@@ -258,8 +269,7 @@ fn faults_are_counted_flagged_and_survived() {
     std::fs::write(&cfg, text).unwrap();
     let prefix = format!("shipcast-test-{}-faults", std::process::id());
     let names = Names { prefix: prefix.clone() };
-    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-    std::thread::sleep(Duration::from_millis(1500));
+    let _daemon = daemon(&cfg);
     let sub = ForecastSubscriber::new(&names).unwrap();
     let field = |t: f64| WaveField {
         components: vec![FieldComponent {
@@ -366,8 +376,7 @@ fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
     let names = Names {
         prefix: format!("shipcast-test-{}-kill", std::process::id()),
     };
-    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-    std::thread::sleep(Duration::from_millis(1500));
+    let _daemon = daemon(&cfg);
     let sub = ForecastSubscriber::new(&names).unwrap();
     let sim_args = [
         "simulate",
@@ -409,16 +418,8 @@ fn a_python_console_decodes_a_live_forecast() {
     );
     let dir = crate::util::scratch_dir("daemon-python");
     let cfg = config(&dir, "python", "");
-    let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-    std::thread::sleep(Duration::from_millis(1500));
-    let _sim = spawn(&[
-        "simulate",
-        "--publish",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--duration",
-        "100",
-    ]);
+    let _daemon = daemon(&cfg);
+    let _sim = simulator(&cfg, "100", &[]);
     let out = Command::new("python3")
         .args([
             repo("tools/console/subscriber.py").to_str().unwrap(),
@@ -452,16 +453,8 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
     let rec_dir = dir.join("logs");
     let cfg = config(&dir, "record", &format!("[record]\ndir = \"{}\"\n", rec_dir.display()));
     {
-        let _daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-        std::thread::sleep(Duration::from_millis(1500));
-        let _sim = spawn(&[
-            "simulate",
-            "--publish",
-            "--config",
-            cfg.to_str().unwrap(),
-            "--duration",
-            "120",
-        ]);
+        let _daemon = daemon(&cfg);
+        let _sim = simulator(&cfg, "120", &[]);
         std::thread::sleep(Duration::from_secs(25));
     } // SIGINT to both: the daemon closes its log
     let logs: Vec<PathBuf> = std::fs::read_dir(&rec_dir)
@@ -518,16 +511,8 @@ fn a_killed_daemon_restarts_and_forecasts_again() {
     let names = Names {
         prefix: format!("shipcast-test-{}-restart", std::process::id()),
     };
-    let mut daemon = spawn(&["run", "--config", cfg.to_str().unwrap()]);
-    std::thread::sleep(Duration::from_millis(1500));
-    let _sim = spawn(&[
-        "simulate",
-        "--publish",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--duration",
-        "200",
-    ]);
+    let mut daemon = daemon(&cfg);
+    let _sim = simulator(&cfg, "200", &[]);
     let sub = ForecastSubscriber::new(&names).unwrap();
     let count_for = |secs: u64| {
         let mut got = vec![];
