@@ -2,7 +2,7 @@
 //! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
 //!
 //! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`], [`skill`].
-//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports), [`replay`] (MCAP logs),
+//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports), [`replay`] (MCAP logs), [`process`] (children),
 //! [`service`] (the daemon) and the `shipcast` binary.
 
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
@@ -11,6 +11,7 @@
 pub mod files;
 pub mod hydro;
 pub mod ipc;
+pub mod process;
 pub mod rao;
 pub mod replay;
 pub mod rom;

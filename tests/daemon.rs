@@ -3,9 +3,10 @@
 //! simulator's truth; fault cases. Each test uses its own service prefix, so they run in parallel.
 
 use crate::util::repo;
+use shipcast::process::Interrupting;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// The bar: heave and pitch correlation at 30 s lead.
@@ -62,25 +63,10 @@ noise_m = 0.05
     p
 }
 
-struct Proc(Child);
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = Command::new("kill").args(["-INT", &self.0.id().to_string()]).status();
-        let t = Instant::now();
-        while t.elapsed() < Duration::from_secs(5) {
-            if let Ok(Some(_)) = self.0.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+type Proc = Interrupting;
 
 fn spawn(args: &[&str]) -> Proc {
-    Proc(
+    Interrupting(
         Command::new(bin())
             .args(args)
             .stdout(Stdio::null())
@@ -395,8 +381,7 @@ fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
     }
     let before = count(&got);
     // SIGKILL: no clean-up at all
-    let _ = sim.0.kill();
-    let _ = sim.0.wait();
+    sim.kill();
     std::thread::sleep(Duration::from_secs(3));
     let _sim2 = spawn(&sim_args);
     got.clear();
@@ -524,8 +509,7 @@ fn a_killed_daemon_restarts_and_forecasts_again() {
     };
     let before = count_for(5);
     // SIGKILL: its ports and shared memory are left behind
-    let _ = daemon.0.kill();
-    let _ = daemon.0.wait();
+    daemon.kill();
     std::thread::sleep(Duration::from_secs(1));
     let _daemon2 = spawn(&["run", "--config", cfg.to_str().unwrap()]);
     let after = count_for(8);

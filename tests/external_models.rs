@@ -28,15 +28,9 @@ const B44: f64 = 2.4e6; // 2 % of critical
 const Q44: f64 = 3.0e7; // N m s^2
 const X44: f64 = 1.0e6; // N m per metre of wave, beam seas
 
-fn flat_system(dir: &std::path::Path, extra: &str, quadratic: bool) -> std::path::PathBuf {
-    write_flat_database(
-        dir,
-        [1e6, 1e6, 1e6, A44, 1e9, 1e9],
-        [0.0; 6],
-        [0.0, 0.0, 1e7, C44, 1e9, 0.0],
-        X44,
-    );
-    let q = if quadratic { Q44 } else { 0.0 };
+/// Writes `system.toml` for one box on the flat database in `dir`: its mass, then `body_keys` (more
+/// keys of the body), then `sections` (connections, tanks).
+fn box_system_file(dir: &std::path::Path, body_keys: &str, sections: &str) -> std::path::PathBuf {
     let text = format!(
         r#"
 wamit = "flat"
@@ -52,18 +46,32 @@ mass_matrix = [
     [1e7, 0, 0, 0, 0, 0], [0, 1e7, 0, 0, 0, 0], [0, 0, 1e7, 0, 0, 0],
     [0, 0, 0, {I44:e}, 0, 0], [0, 0, 0, 0, 1e9, 0], [0, 0, 0, 0, 0, 1e9],
 ]
-linear_damping = [
-    [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0],
-    [0, 0, 0, {B44:e}, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0],
-]
-quadratic_damping = [0, 0, 0, {q:e}, 0, 0]
-active_dofs = ["roll"]
-{extra}
-"#
+{body_keys}
+{sections}"#
     );
     let p = dir.join("system.toml");
     std::fs::write(&p, text).unwrap();
     p
+}
+
+fn flat_system(dir: &std::path::Path, extra: &str, quadratic: bool) -> std::path::PathBuf {
+    write_flat_database(
+        dir,
+        [1e6, 1e6, 1e6, A44, 1e9, 1e9],
+        [0.0; 6],
+        [0.0, 0.0, 1e7, C44, 1e9, 0.0],
+        X44,
+    );
+    let q = if quadratic { Q44 } else { 0.0 };
+    let body_keys = format!(
+        r#"linear_damping = [
+    [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0],
+    [0, 0, 0, {B44:e}, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0],
+]
+quadratic_damping = [0, 0, 0, {q:e}, 0, 0]
+active_dofs = ["roll"]"#
+    );
+    box_system_file(dir, &body_keys, extra)
 }
 
 /// Extrema of a sampled signal, refined by a parabola through the three samples around each.
@@ -261,27 +269,7 @@ fn moored_box(dir: &std::path::Path) -> std::path::PathBuf {
         })
         .collect();
     let fenders = "[[connection]]\nname = \"fender0\"\nkind = \"fender\"\nbody_a = \"box\"\npoint_a_m = [10.0, 10.0, 0.0]\nbody_b = \"earth\"\npoint_b_m = [10.0, 12.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\ninitial_compression_m = 0.05\ncurve = [[0.2, 1.0e5], [0.5, 5.0e5]]\n\n[[connection]]\nname = \"fender1\"\nkind = \"fender\"\nbody_a = \"box\"\npoint_a_m = [-10.0, 10.0, 0.0]\nbody_b = \"earth\"\npoint_b_m = [-10.0, 12.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\ninitial_compression_m = 0.0\ncurve = [[0.2, 1.0e5], [0.5, 5.0e5]]\n";
-    let text = format!(
-        r#"
-wamit = "flat"
-rho = 1000.0
-g = 9.81
-water_depth = "infinite"
-a_inf = "database"
-
-[[body]]
-name = "box"
-position = [0.0, 0.0, 0.0]
-mass_matrix = [
-    [1e7, 0, 0, 0, 0, 0], [0, 1e7, 0, 0, 0, 0], [0, 0, 1e7, 0, 0, 0],
-    [0, 0, 0, {I44:e}, 0, 0], [0, 0, 0, 0, 1e9, 0], [0, 0, 0, 0, 0, 1e9],
-]
-
-{lines}{fenders}"#
-    );
-    let p = dir.join("system.toml");
-    std::fs::write(&p, text).unwrap();
-    p
+    box_system_file(dir, "", &format!("{lines}{fenders}"))
 }
 
 /// Energy drift allowed over 200 s of undamped motion with lines and fenders: Newmark's average

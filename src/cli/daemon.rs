@@ -473,37 +473,18 @@ pub struct DemoArgs {
     seconds: Option<f64>,
 }
 
-/// Kills a child with SIGINT, then waits (SIGKILL after 5 s).
-struct Child(std::process::Child);
-
-impl Drop for Child {
-    fn drop(&mut self) {
-        let _ = std::process::Command::new("kill")
-            .args(["-INT", &self.0.id().to_string()])
-            .status();
-        let t = Instant::now();
-        while t.elapsed() < Duration::from_secs(5) {
-            if let Ok(Some(_)) = self.0.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 /// `shipcast demo`: the synthetic sea publishing radar and IMU data, the daemon on the bundled demo,
 /// and a live view of the forecasts and of their skill so far (the forecasts of 30 s ago against the
 /// motion measured now). Ctrl-C stops all three.
 pub fn demo(a: &DemoArgs) -> Result<()> {
     use shipcast::ipc::MotionSubscriber;
+    use shipcast::process::Interrupting;
     let cfg = load_config(&a.config)?;
     let sys = files::load_system(&system_path(&cfg))?.system;
     let exe = std::env::current_exe()?;
     let config = a.config.to_str().context("config path is not UTF-8")?.to_string();
-    let spawn = |args: &[&str]| -> Result<Child> {
-        Ok(Child(
+    let spawn = |args: &[&str]| -> Result<Interrupting> {
+        Ok(Interrupting(
             std::process::Command::new(&exe)
                 .args(args)
                 .stdout(std::process::Stdio::null())

@@ -9,13 +9,12 @@
 
 pub mod wire;
 
-use crate::waves::field::{FieldComponent, Region, WaveField};
+use crate::waves::field::WaveField;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
-use num_complex::Complex64;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -131,30 +130,8 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
             h.n_components
         ));
     }
-    let f = WaveField {
-        components: payload
-            .chunks_exact(4)
-            .map(|c| FieldComponent {
-                omega_rad_s: c[0],
-                direction_rad: c[1],
-                amplitude_m: Complex64::new(c[2], c[3]),
-            })
-            .collect(),
-        reference_m: [h.ref_east_m, h.ref_north_m],
-        time_s: h.time_s,
-        g_m_s2: h.g_m_s2,
-        depth_m: if h.depth_m > 0.0 { Some(h.depth_m) } else { None },
-        region: if h.radius_m > 0.0 {
-            Region::Disc {
-                centre_m: [h.ref_east_m, h.ref_north_m],
-                radius_m: h.radius_m,
-            }
-        } else {
-            Region::Everywhere
-        },
-    };
-    f.validate().map_err(|e| format!("wave field: {e}"))?;
-    Ok(f)
+    let rows = payload.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]);
+    WaveField::from_flat(h.flat(), rows).map_err(|e| format!("wave field: {e}"))
 }
 
 /// What the input thread forwards.
@@ -371,25 +348,8 @@ impl SensorPublisher {
     }
 
     pub fn waves(&self, f: &WaveField) -> Result<()> {
-        let mut values = Vec::with_capacity(4 * f.components.len());
-        for c in &f.components {
-            values.extend([c.omega_rad_s, c.direction_rad, c.amplitude_m.re, c.amplitude_m.im]);
-        }
-        let radius_m = match f.region {
-            Region::Disc { radius_m, .. } => radius_m,
-            _ => 0.0,
-        };
-        let h = WaveHeader {
-            schema_version: SCHEMA_VERSION,
-            n_components: f.components.len() as u32,
-            time_s: f.time_s,
-            ref_east_m: f.reference_m[0],
-            ref_north_m: f.reference_m[1],
-            radius_m,
-            depth_m: f.depth_m.unwrap_or(0.0),
-            g_m_s2: f.g_m_s2,
-            reserved: 0.0,
-        };
+        let values: Vec<f64> = f.flat_rows().flatten().collect();
+        let h = WaveHeader::of(f.components.len(), &f.flat_header());
         let s = self.waves.loan_slice_uninit(values.len()).map_err(err)?;
         let mut s = s.write_from_slice(&values);
         *s.user_header_mut() = h;

@@ -16,6 +16,7 @@
 //!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad).
 //! - `status`: [`Status`].
 
+use crate::waves::field::FlatHeader;
 use iceoryx2::prelude::*;
 
 pub const SCHEMA_VERSION: u32 = 1;
@@ -92,6 +93,34 @@ pub struct WaveHeader {
     pub depth_m: f64,
     pub g_m_s2: f64,
     pub reserved: f64,
+}
+
+impl WaveHeader {
+    /// The header of a field of `n_components` components (this schema version).
+    pub fn of(n_components: usize, h: &FlatHeader) -> WaveHeader {
+        WaveHeader {
+            schema_version: SCHEMA_VERSION,
+            n_components: n_components as u32,
+            time_s: h.time_s,
+            ref_east_m: h.reference_m[0],
+            ref_north_m: h.reference_m[1],
+            radius_m: h.radius_m,
+            depth_m: h.depth_m,
+            g_m_s2: h.g_m_s2,
+            reserved: 0.0,
+        }
+    }
+
+    /// The field's header numbers.
+    pub fn flat(&self) -> FlatHeader {
+        FlatHeader {
+            time_s: self.time_s,
+            reference_m: [self.ref_east_m, self.ref_north_m],
+            radius_m: self.radius_m,
+            depth_m: self.depth_m,
+            g_m_s2: self.g_m_s2,
+        }
+    }
 }
 
 /// Header of a forecast sample. 96 bytes.

@@ -15,8 +15,7 @@
 //!   "compute_ms", "horizon_s": [..], "values": [...]}` (series-major as on the wire)
 
 use crate::ipc::wire::{ForecastHeader, MotionSample, SCHEMA_VERSION};
-use crate::waves::field::{FieldComponent, Region, WaveField};
-use num_complex::Complex64;
+use crate::waves::field::{FlatHeader, WaveField};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{BufWriter, Seek, Write};
@@ -68,50 +67,27 @@ impl MotionRecord {
 
 impl WavesRecord {
     pub fn of(f: &WaveField) -> WavesRecord {
+        let h = f.flat_header();
         WavesRecord {
-            time_s: f.time_s,
-            ref_east_m: f.reference_m[0],
-            ref_north_m: f.reference_m[1],
-            radius_m: match f.region {
-                Region::Disc { radius_m, .. } => radius_m,
-                _ => 0.0,
-            },
-            depth_m: f.depth_m.unwrap_or(0.0),
-            g_m_s2: f.g_m_s2,
-            components: f
-                .components
-                .iter()
-                .map(|c| [c.omega_rad_s, c.direction_rad, c.amplitude_m.re, c.amplitude_m.im])
-                .collect(),
+            time_s: h.time_s,
+            ref_east_m: h.reference_m[0],
+            ref_north_m: h.reference_m[1],
+            radius_m: h.radius_m,
+            depth_m: h.depth_m,
+            g_m_s2: h.g_m_s2,
+            components: f.flat_rows().collect(),
         }
     }
 
     pub fn field(&self) -> Result<WaveField, String> {
-        let f = WaveField {
-            components: self
-                .components
-                .iter()
-                .map(|c| FieldComponent {
-                    omega_rad_s: c[0],
-                    direction_rad: c[1],
-                    amplitude_m: Complex64::new(c[2], c[3]),
-                })
-                .collect(),
-            reference_m: [self.ref_east_m, self.ref_north_m],
+        let h = FlatHeader {
             time_s: self.time_s,
+            reference_m: [self.ref_east_m, self.ref_north_m],
+            radius_m: self.radius_m,
+            depth_m: self.depth_m,
             g_m_s2: self.g_m_s2,
-            depth_m: (self.depth_m > 0.0).then_some(self.depth_m),
-            region: if self.radius_m > 0.0 {
-                Region::Disc {
-                    centre_m: [self.ref_east_m, self.ref_north_m],
-                    radius_m: self.radius_m,
-                }
-            } else {
-                Region::Everywhere
-            },
         };
-        f.validate().map_err(|e| e.to_string())?;
-        Ok(f)
+        WaveField::from_flat(h, self.components.iter().copied()).map_err(|e| e.to_string())
     }
 }
 

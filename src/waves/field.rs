@@ -55,6 +55,19 @@ pub struct WaveField {
     pub region: Region,
 }
 
+/// A field's header numbers in the flat layout shared by the wire (`ipc::wire::WaveHeader`) and the
+/// log (`replay::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
+/// Radius 0 = no region known (read back as [`Region::Everywhere`]; a probe's point travels as its
+/// reference point with radius 0); depth 0 = infinite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlatHeader {
+    pub time_s: f64,
+    pub reference_m: [f64; 2],
+    pub radius_m: f64,
+    pub depth_m: f64,
+    pub g_m_s2: f64,
+}
+
 /// Converts a compass heading (clockwise from north, degrees) to a direction counterclockwise from
 /// east, radians.
 pub fn heading_from_compass_deg(compass_deg: f64) -> f64 {
@@ -88,6 +101,56 @@ impl WaveField {
     }
 
     /// Checks every component: positive finite frequency, finite direction and amplitude.
+    /// The header numbers of the flat layout ([`FlatHeader`]).
+    pub fn flat_header(&self) -> FlatHeader {
+        FlatHeader {
+            time_s: self.time_s,
+            reference_m: self.reference_m,
+            radius_m: match self.region {
+                Region::Disc { radius_m, .. } => radius_m,
+                _ => 0.0,
+            },
+            depth_m: self.depth_m.unwrap_or(0.0),
+            g_m_s2: self.g_m_s2,
+        }
+    }
+
+    /// The components as flat rows `[omega_rad_s, direction_rad, re, im]`.
+    pub fn flat_rows(&self) -> impl Iterator<Item = [f64; 4]> + '_ {
+        self.components
+            .iter()
+            .map(|c| [c.omega_rad_s, c.direction_rad, c.amplitude_m.re, c.amplitude_m.im])
+    }
+
+    /// A field from the flat layout, validated (the inverse of [`Self::flat_header`] and
+    /// [`Self::flat_rows`]).
+    pub fn from_flat(h: FlatHeader, rows: impl IntoIterator<Item = [f64; 4]>) -> Result<WaveField> {
+        let f = WaveField {
+            components: rows
+                .into_iter()
+                .map(|c| FieldComponent {
+                    omega_rad_s: c[0],
+                    direction_rad: c[1],
+                    amplitude_m: Complex64::new(c[2], c[3]),
+                })
+                .collect(),
+            reference_m: h.reference_m,
+            time_s: h.time_s,
+            g_m_s2: h.g_m_s2,
+            depth_m: (h.depth_m > 0.0).then_some(h.depth_m),
+            region: if h.radius_m > 0.0 {
+                Region::Disc {
+                    centre_m: h.reference_m,
+                    radius_m: h.radius_m,
+                }
+            } else {
+                Region::Everywhere
+            },
+        };
+        f.validate()?;
+        Ok(f)
+    }
+
     pub fn validate(&self) -> Result<()> {
         for (i, c) in self.components.iter().enumerate() {
             if !(c.omega_rad_s.is_finite() && c.omega_rad_s > 0.0) {
