@@ -1,16 +1,18 @@
 //! shipcast: real-time motion forecasts for one or more ships, from a Cummins reduced-order model driven
 //! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
 //!
-//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`], [`skill`].
+//! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`], [`skill`], [`operation`], [`console`].
 //! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports), [`replay`] (MCAP logs), [`process`] (children),
 //! [`service`] (the daemon) and the `shipcast` binary.
 
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
 #![allow(clippy::needless_range_loop)]
 
+pub mod console;
 pub mod files;
 pub mod hydro;
 pub mod ipc;
+pub mod operation;
 pub mod process;
 pub mod rao;
 pub mod replay;

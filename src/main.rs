@@ -48,6 +48,8 @@ enum Command {
     Simulate(cli::daemon::SimulateArgs),
     /// Print forecasts and status as they arrive (the reference subscriber).
     Watch(cli::daemon::WatchArgs),
+    /// The operator's terminal view: motion and forecast per channel, limits, quiet windows, inputs.
+    Console(cli::console::ConsoleArgs),
     /// One command to try it: the synthetic sea, the daemon and a live view of forecasts and skill.
     Demo(cli::daemon::DemoArgs),
     /// A recorded log through the daemon's engine; with --report, skill against lead time.
@@ -212,6 +214,8 @@ fn main() -> ExitCode {
             }
             Err(e) => Some(Err(e)),
         },
+        // a full-screen view: logs would tear it
+        Command::Console(a) => Some(cli::console::run(a)),
         Command::Simulate(_) | Command::Watch(_) | Command::Demo(_) => {
             init_logging("info", false);
             None
@@ -247,6 +251,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Simulate(args) => cli::daemon::simulate(&args),
         Command::Watch(args) => cli::daemon::watch(&args),
         Command::Demo(args) => cli::daemon::demo(&args),
+        Command::Console(_) => Ok(()),
         Command::Replay(args) => cli::replay::run(&args),
     }
 }

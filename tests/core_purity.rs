@@ -13,6 +13,8 @@ const CORE: &[&str] = &[
     "src/skill.rs",
     "src/sim.rs",
     "src/service/history.rs",
+    "src/operation.rs",
+    "src/console",
 ];
 const FORBIDDEN: &[&str] = &[
     "tokio",
@@ -26,6 +28,7 @@ const FORBIDDEN: &[&str] = &[
     "std::env",
     "std::process",
     "std::thread",
+    "crossterm",
 ];
 
 fn rust_files(p: &Path, out: &mut Vec<PathBuf>) {

@@ -13,12 +13,12 @@ use std::time::{Duration, Instant};
 const MIN_CORRELATION: f64 = 0.9;
 const LEAD_S: f64 = 30.0;
 
-fn bin() -> &'static str {
+pub(crate) fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_shipcast")
 }
 
 /// A config for the one-ship demo with a unique prefix; `extra` is appended (TOML).
-fn config(dir: &Path, name: &str, extra: &str) -> PathBuf {
+pub(crate) fn config(dir: &Path, name: &str, extra: &str) -> PathBuf {
     let system = repo("config/vessels/ship/system.toml");
     let text = format!(
         r#"
@@ -63,7 +63,7 @@ noise_m = 0.05
     p
 }
 
-type Proc = Interrupting;
+pub(crate) type Proc = Interrupting;
 
 fn spawn(args: &[&str]) -> Proc {
     Interrupting(
@@ -77,14 +77,14 @@ fn spawn(args: &[&str]) -> Proc {
 }
 
 /// Starts `shipcast run` on a config and waits until its ports are up.
-fn daemon(cfg: &Path) -> Proc {
+pub(crate) fn daemon(cfg: &Path) -> Proc {
     let d = spawn(&["run", "--config", cfg.to_str().unwrap()]);
     std::thread::sleep(Duration::from_millis(1500));
     d
 }
 
 /// Starts `shipcast simulate --publish` for `duration_s` (plus any further arguments).
-fn simulator(cfg: &Path, duration_s: &str, more: &[&str]) -> Proc {
+pub(crate) fn simulator(cfg: &Path, duration_s: &str, more: &[&str]) -> Proc {
     let mut args = vec![
         "simulate",
         "--publish",

@@ -62,7 +62,7 @@ pub fn load_config(path: &Path) -> Result<ShipcastConfig> {
     Ok(config::load(path)?)
 }
 
-fn system_path(cfg: &ShipcastConfig) -> PathBuf {
+pub fn system_path(cfg: &ShipcastConfig) -> PathBuf {
     cfg.dir.join(&cfg.system.file)
 }
 

@@ -21,6 +21,10 @@ pub struct ShipcastConfig {
     pub record: RecordConfig,
     #[serde(default)]
     pub simulate: SimulateConfig,
+    #[serde(default)]
+    pub operation: OperationConfig,
+    #[serde(default)]
+    pub console: ConsoleConfig,
     /// Directory of the config file (relative paths are resolved against it); set by [`load`].
     #[serde(skip)]
     pub dir: PathBuf,
@@ -255,6 +259,139 @@ impl Default for ImuConfig {
     }
 }
 
+/// The operation the console watches and replay scores windows for.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OperationConfig {
+    /// How long the operation needs quiet motion, s.
+    pub duration_s: f64,
+    /// Channels and limits; empty: heave (1 m) and roll (2 deg) of every vessel.
+    pub channels: Vec<ChannelConfig>,
+}
+
+impl Default for OperationConfig {
+    fn default() -> Self {
+        OperationConfig {
+            duration_s: 60.0,
+            channels: vec![],
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelConfig {
+    /// `<vessel>.<dof>`, `<point>.<x|y|z>` or `<relative_motion>.<x|y|z>` (`crate::operation`).
+    pub name: String,
+    /// |value| <= limit is inside: m, or deg for rotations.
+    pub limit: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ConsoleConfig {
+    /// Measured past shown before "now", s.
+    pub history_s: f64,
+    pub colours: ColourConfig,
+}
+
+impl Default for ConsoleConfig {
+    fn default() -> Self {
+        ConsoleConfig {
+            history_s: 60.0,
+            colours: ColourConfig::default(),
+        }
+    }
+}
+
+/// Colour names as ratatui reads them ("red", "lightcyan", "darkgray", "#ffaa00", "208").
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ColourConfig {
+    pub measured: String,
+    pub forecast: String,
+    pub beyond_horizon: String,
+    pub limit: String,
+    pub go: String,
+    pub no_go: String,
+    pub caution: String,
+}
+
+impl Default for ColourConfig {
+    fn default() -> Self {
+        ColourConfig {
+            measured: "white".into(),
+            forecast: "cyan".into(),
+            beyond_horizon: "darkgray".into(),
+            limit: "red".into(),
+            go: "green".into(),
+            no_go: "red".into(),
+            caution: "yellow".into(),
+        }
+    }
+}
+
+impl ColourConfig {
+    /// The colours, or the key of the first that ratatui cannot read.
+    pub fn parse(&self) -> Result<crate::console::Colours, (String, String)> {
+        let c = |k: &str, v: &str| {
+            v.parse::<ratatui::style::Color>()
+                .map_err(|_| (format!("console.colours.{k}"), format!("not a colour: \"{v}\"")))
+        };
+        Ok(crate::console::Colours {
+            measured: c("measured", &self.measured)?,
+            forecast: c("forecast", &self.forecast)?,
+            beyond_horizon: c("beyond_horizon", &self.beyond_horizon)?,
+            limit: c("limit", &self.limit)?,
+            go: c("go", &self.go)?,
+            no_go: c("no_go", &self.no_go)?,
+            caution: c("caution", &self.caution)?,
+        })
+    }
+}
+
+impl ShipcastConfig {
+    /// The operation's channels resolved against the system (its vessels, points and relative
+    /// motions); the error names the config file and the channel's key.
+    pub fn operation_channels(
+        &self,
+        vessels: &[String],
+        ext: &crate::hydro::external::External,
+        file: &Path,
+    ) -> Result<Vec<crate::operation::Channel>, Error> {
+        use crate::operation::{Channel, resolve};
+        if self.operation.channels.is_empty() {
+            let mut out = vec![];
+            for v in vessels {
+                for (dof, limit) in [("heave", 1.0), ("roll", 2.0)] {
+                    let name = format!("{v}.{dof}");
+                    if let Ok(source) = resolve(&name, vessels, ext) {
+                        out.push(Channel { name, source, limit });
+                    }
+                }
+            }
+            return Ok(out);
+        }
+        self.operation
+            .channels
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let source = resolve(&c.name, vessels, ext).map_err(|msg| Error::Key {
+                    file: file.display().to_string(),
+                    key: format!("operation.channels[{i}].name"),
+                    msg,
+                })?;
+                Ok(Channel {
+                    name: c.name.clone(),
+                    source,
+                    limit: c.limit,
+                })
+            })
+            .collect()
+    }
+}
+
 /// A configuration error: the file or the key, and why.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -342,6 +479,12 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             format!("must be positive, found {}", c.record.rotate_mb),
         ));
     }
+    pos("operation.duration_s", c.operation.duration_s)?;
+    for (i, ch) in c.operation.channels.iter().enumerate() {
+        pos(&format!("operation.channels[{i}].limit"), ch.limit)?;
+    }
+    pos("console.history_s", c.console.history_s)?;
+    c.console.colours.parse()?;
     let s = &c.simulate;
     pos("simulate.duration_s", s.duration_s)?;
     pos("simulate.speed", s.speed)?;

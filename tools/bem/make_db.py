@@ -131,6 +131,9 @@ PRESETS = {
         panel_m=3.0,
         omegas=np.round(np.arange(0.05, 1.6001, 0.025), 4),
         headings_deg=np.arange(0.0, 360.0, 30.0),
+        # points of interest (outputs only: they change no motion)
+        points=[("crane_tip", "carrier", (0.0, 14.0, 30.0)), ("lighter_hatch", "lighter", (0.0, 0.0, 3.0))],
+        relative_motions=[("hook_over_hatch", "crane_tip", "lighter_hatch")],
     ),
     # two ships side by side: the carrier and a 120 m x 20 m x 7 m lighter to port, 5 m gap at the waterline
     "pair": dict(
@@ -286,6 +289,10 @@ def main():
                 rows = [[0.0] * 6 for _ in range(6)]
                 rows[3][3] = b44
                 f.write("linear_damping = [\n" + "".join(f"    [{', '.join(f'{v:.9e}' for v in r)}],\n" for r in rows) + "]\n")
+        for name, body, at in p.get("points", []):
+            f.write(f'\n[[point]]\nname = "{name}"\nbody = "{body}"\nposition_m = [{at[0]}, {at[1]}, {at[2]}]\n')
+        for name, a, b in p.get("relative_motions", []):
+            f.write(f'\n[[relative_motion]]\nname = "{name}"\npoint_a = "{a}"\npoint_b = "{b}"\n')
     with open(os.path.join(args.outdir, "bem_info.toml"), "w") as f:
         f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
         f.write(f"solve_seconds = {t_solve:.1f}\n")

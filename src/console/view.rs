@@ -1,0 +1,561 @@
+//! Drawing the console (pure: into a ratatui frame). The words an operator reads are decided by
+//! [`banner`] and [`health_lines`] (tested on their own); [`draw`] lays them out with the charts.
+
+use super::{Console, Link};
+use crate::operation::{Channel, Verdict};
+use ratatui::Frame;
+use ratatui::layout::{Alignment, Constraint, Layout, Rect};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Axis, Block, Borders, Chart, Clear, Dataset, GraphType, Paragraph, Wrap};
+
+/// How loud a line is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Severity {
+    Ok,
+    Caution,
+    Alarm,
+}
+
+/// Below this size the console shows text only.
+const MIN_CHART_WIDTH: u16 = 60;
+const MIN_CHART_HEIGHT: u16 = 16;
+
+fn colour(c: &Console, s: Severity) -> Color {
+    match s {
+        Severity::Ok => c.settings.colours.go,
+        Severity::Caution => c.settings.colours.caution,
+        Severity::Alarm => c.settings.colours.no_go,
+    }
+}
+
+/// The one line that matters: can the operation start now, or why the console cannot say.
+pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
+    let d = c.settings.duration_s;
+    match c.link(now_wall_s) {
+        Link::Waiting => {
+            return (
+                Severity::Caution,
+                "Waiting for shipcast: no forecast or status yet (is `shipcast run` running?)".into(),
+            );
+        }
+        Link::Stopped => {
+            return (
+                Severity::Alarm,
+                "shipcast has STOPPED: no forecast. Do not use the traces below.".into(),
+            );
+        }
+        Link::Silent { silent_s } => {
+            return (
+                Severity::Alarm,
+                format!("shipcast NOT RESPONDING for {silent_s:.0} s: the forecast below is STALE, do not use it"),
+            );
+        }
+        Link::Live => {}
+    }
+    if !c.forecast_is_current(now_wall_s) {
+        let h = c.health.as_ref();
+        let has = |f: &str| h.is_some_and(|h| h.flags.contains(&f));
+        let why = if has("no_waves") {
+            match h.map(|h| h.wave_age_s) {
+                Some(a) if a >= 0.0 => format!("radar data {a:.0} s old"),
+                _ => "no radar data yet".into(),
+            }
+        } else if has("no_motion") {
+            let stale: Vec<String> = h
+                .map(|h| {
+                    h.motion_age_s
+                        .iter()
+                        .zip(&c.vessels)
+                        .filter(|(a, _)| **a < 0.0 || **a > 2.0)
+                        .map(|(a, n)| {
+                            if *a < 0.0 {
+                                format!("no IMU data from {n}")
+                            } else {
+                                format!("{n} IMU data {a:.0} s old")
+                            }
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            if stale.is_empty() {
+                "no motion data".into()
+            } else {
+                stale.join(", ")
+            }
+        } else if has("numerical_trouble") {
+            "the model diverged".into()
+        } else {
+            match &c.forecast {
+                Some(f) => format!("last forecast {:.0} s ago", now_wall_s - f.received_wall_s),
+                None => "no forecast yet".into(),
+            }
+        };
+        return (
+            Severity::Alarm,
+            format!("Forecast suspended: {why}. NO-GO until it returns."),
+        );
+    }
+    let Some(o) = c.outlook() else {
+        return (Severity::Caution, "No channels chosen: press a to add one".into());
+    };
+    match o.verdict {
+        Verdict::Go { window_s } => (
+            Severity::Ok,
+            format!("GO: every channel inside its limits for the next {window_s:.0} s ({d:.0} s operation)"),
+        ),
+        Verdict::Unknown => (
+            Severity::Caution,
+            format!(
+                "CAN'T TELL: the forecast is trusted {:.0} s ahead, less than the {d:.0} s operation",
+                o.trusted_s
+            ),
+        ),
+        Verdict::NoGo { next_window_in_s } => {
+            let who = match &o.first_exceedance {
+                Some((n, t)) if *t <= 0.0 => format!("{n} outside its limit now"),
+                Some((n, t)) => format!("{n} leaves its limit in {}", fmt_in(*t)),
+                None => "a channel leaves its limit".into(),
+            };
+            let next = match next_window_in_s {
+                Some(t) => format!("next window in {}", fmt_in(t)),
+                None => format!("no {d:.0} s window within the trusted {:.0} s", o.trusted_s),
+            };
+            (Severity::Alarm, format!("NO-GO: {who}; {next}"))
+        }
+    }
+}
+
+/// The inputs' health in an operator's words.
+pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
+    let mut out = vec![];
+    let link = c.link(now_wall_s);
+    out.push(match link {
+        Link::Waiting => (Severity::Caution, "shipcast: waiting".to_string()),
+        Link::Live => (
+            Severity::Ok,
+            format!("shipcast: live (forecast every {:.1} s)", c.settings.period_s),
+        ),
+        Link::Silent { silent_s } => (Severity::Alarm, format!("shipcast: silent for {silent_s:.0} s")),
+        Link::Stopped => (Severity::Alarm, "shipcast: stopped".into()),
+    });
+    if let Some(f) = &c.forecast {
+        let age = now_wall_s - f.received_wall_s;
+        let s = if c.forecast_is_current(now_wall_s) {
+            Severity::Ok
+        } else {
+            Severity::Alarm
+        };
+        out.push((
+            s,
+            format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
+        ));
+        for (n, h) in c.vessels.iter().zip(&f.horizon_s) {
+            out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s")));
+        }
+    }
+    if let Some(h) = &c.health {
+        out.push(match h.wave_age_s {
+            a if a < 0.0 => (Severity::Alarm, "Radar: no data yet".into()),
+            a if h.flags.contains(&"no_waves") => {
+                (Severity::Alarm, format!("Radar: data {a:.0} s old, forecast suspended"))
+            }
+            a if h.flags.contains(&"stale_waves") => (
+                Severity::Caution,
+                format!("Radar: data {a:.0} s old, forecast less sure"),
+            ),
+            a => (Severity::Ok, format!("Radar: data {a:.1} s old")),
+        });
+        for ((n, a), r) in c.vessels.iter().zip(&h.motion_age_s).zip(&h.motion_rate_hz) {
+            out.push(if *a < 0.0 {
+                (Severity::Alarm, format!("{n} IMU: no data yet"))
+            } else if *a > 2.0 {
+                (Severity::Alarm, format!("{n} IMU: no data for {a:.0} s"))
+            } else {
+                (Severity::Ok, format!("{n} IMU: {a:.1} s old, {r:.0} Hz"))
+            });
+        }
+        if h.flags.contains(&"history_short") {
+            out.push((Severity::Caution, "Motion history still filling: less sure".into()));
+        }
+        if h.flags.contains(&"history_gap") {
+            out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));
+        }
+        if h.flags.contains(&"numerical_trouble") {
+            out.push((Severity::Alarm, "The model diverged: no forecast".into()));
+        }
+        if h.overruns > 0 {
+            out.push((Severity::Caution, format!("{} forecasts ran late", h.overruns)));
+        }
+    }
+    out
+}
+
+/// Four evenly spaced time labels (ratatui spreads labels evenly), "now" at 0.
+fn time_labels(from_s: f64, to_s: f64) -> Vec<String> {
+    (0..4)
+        .map(|i| {
+            let t = from_s + (to_s - from_s) * i as f64 / 3.0;
+            if t.abs() < 0.05 * (to_s - from_s) {
+                "now".to_string()
+            } else {
+                format!("{t:+.0} s")
+            }
+        })
+        .collect()
+}
+
+/// A lead time as an operator reads it.
+fn fmt_in(t: f64) -> String {
+    if t < 10.0 {
+        format!("{t:.1} s")
+    } else {
+        format!("{t:.0} s")
+    }
+}
+
+fn fmt_window(w: &crate::operation::Window) -> String {
+    let start = if w.start_s <= 0.0 {
+        "now".to_string()
+    } else {
+        format!("in {:.0} s", w.start_s)
+    };
+    if w.open_end {
+        format!("{start:>8}, at least {:.0} s", w.length_s())
+    } else {
+        format!("{start:>8}, {:.0} s long", w.length_s())
+    }
+}
+
+/// Draws the whole console for wall time `now_wall_s`.
+pub fn draw(frame: &mut Frame, c: &Console, now_wall_s: f64) {
+    let area = frame.area();
+    if area.width < MIN_CHART_WIDTH || area.height < MIN_CHART_HEIGHT {
+        draw_text(frame, area, c, now_wall_s);
+        return;
+    }
+    let [top, middle, bottom] =
+        Layout::vertical([Constraint::Length(3), Constraint::Min(8), Constraint::Length(1)]).areas(area);
+    let (sev, text) = banner(c, now_wall_s);
+    frame.render_widget(
+        Paragraph::new(Line::from(Span::styled(
+            text,
+            Style::default().fg(colour(c, sev)).add_modifier(Modifier::BOLD),
+        )))
+        .block(Block::default().borders(Borders::ALL).title(" shipcast console ")),
+        top,
+    );
+    let [charts, side] = Layout::horizontal([Constraint::Min(40), Constraint::Length(40)]).areas(middle);
+    let n = c.settings.channels.len().max(1);
+    let rows = Layout::vertical(vec![Constraint::Ratio(1, n as u32); n]).split(charts);
+    for (i, ch) in c.settings.channels.iter().enumerate() {
+        draw_chart(frame, rows[i], c, ch, i == c.selected, now_wall_s);
+    }
+    draw_side(frame, side, c, now_wall_s);
+    let hint = c
+        .note
+        .clone()
+        .unwrap_or_else(|| "? help  ↑↓ channel  +/- limit  [/] duration  a add  x remove  q quit".into());
+    frame.render_widget(Paragraph::new(hint).style(Style::default().fg(Color::Gray)), bottom);
+    if c.help {
+        draw_help(frame, area);
+    }
+}
+
+fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected: bool, now_wall_s: f64) {
+    let colours = &c.settings.colours;
+    let current = c.forecast_is_current(now_wall_s);
+    let hist = c.settings.history_s;
+    let (t0, dt) = c.forecast.as_ref().map_or_else(
+        || (c.latest_measured_s().unwrap_or(0.0), 1.0),
+        |f| (f.issue_time_s, f.dt_s),
+    );
+    let fc = c.forecast_channel(ch);
+    let span_s = (fc.len().max(1) - 1) as f64 * dt;
+    let horizon = c.horizon_of(ch).min(span_s);
+    let k_h = crate::operation::trusted_samples(fc.len(), dt, horizon);
+    let pts = |r: std::ops::Range<usize>| -> Vec<(f64, f64)> {
+        r.filter(|k| fc[*k].is_finite())
+            .map(|k| (k as f64 * dt, fc[k]))
+            .collect()
+    };
+    let trusted = pts(0..k_h);
+    let beyond = pts(k_h.saturating_sub(1)..fc.len());
+    let measured = c.measured_channel(ch, t0, -hist);
+    let x_max = span_s.max(10.0);
+    let peak = trusted
+        .iter()
+        .chain(&beyond)
+        .chain(&measured)
+        .map(|p| p.1.abs())
+        .filter(|v| v.is_finite())
+        .fold(ch.limit * 1.2, f64::max);
+    let y = peak * 1.05;
+    let limit_hi = [(-hist, ch.limit), (x_max, ch.limit)];
+    let limit_lo = [(-hist, -ch.limit), (x_max, -ch.limit)];
+    let horizon_mark = [(horizon, -y), (horizon, y)];
+    let now_mark = [(0.0, -y), (0.0, y)];
+    let fc_colour = if current {
+        colours.forecast
+    } else {
+        colours.beyond_horizon
+    };
+    let mut sets = vec![
+        set(&limit_hi, colours.limit),
+        set(&limit_lo, colours.limit),
+        set(&now_mark, Color::DarkGray),
+    ];
+    if c.forecast.is_some() {
+        sets.push(set(&horizon_mark, colours.beyond_horizon));
+        sets.push(set(&beyond, colours.beyond_horizon));
+        sets.push(set(&trusted, fc_colour));
+    }
+    sets.push(set(&measured, colours.measured));
+    let marker = if selected { "▶ " } else { "" };
+    let status = if c.forecast.is_none() {
+        String::new()
+    } else if current {
+        format!(" · trusted {horizon:.0} s")
+    } else {
+        " · STALE".into()
+    };
+    let title = format!(" {marker}{} ({}) limit ±{} {status} ", ch.name, ch.unit(), ch.limit);
+    let title_style = if selected {
+        Style::default().add_modifier(Modifier::BOLD)
+    } else {
+        Style::default()
+    };
+    let chart = Chart::new(sets)
+        .block(
+            Block::default()
+                .borders(Borders::ALL)
+                .title(Span::styled(title, title_style)),
+        )
+        .x_axis(
+            Axis::default()
+                .bounds([-hist, x_max])
+                .labels(time_labels(-hist, x_max))
+                .style(Style::default().fg(Color::Gray)),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([-y, y])
+                .labels([format!("{:.1}", -y), "0".into(), format!("{y:.1}")])
+                .style(Style::default().fg(Color::Gray)),
+        );
+    frame.render_widget(chart, area);
+}
+
+/// A line through `data`.
+fn set(data: &[(f64, f64)], col: Color) -> Dataset<'_> {
+    Dataset::default()
+        .marker(Marker::Braille)
+        .graph_type(GraphType::Line)
+        .style(Style::default().fg(col))
+        .data(data)
+}
+
+fn draw_side(frame: &mut Frame, area: Rect, c: &Console, now_wall_s: f64) {
+    let [win, health] = Layout::vertical([Constraint::Percentage(45), Constraint::Min(4)]).areas(area);
+    let d = c.settings.duration_s;
+    let mut lines = vec![];
+    match (c.forecast_is_current(now_wall_s), c.outlook()) {
+        (true, Some(o)) => {
+            if o.windows.is_empty() {
+                lines.push(Line::from(format!("none in the trusted {:.0} s", o.trusted_s)));
+            }
+            for w in o.windows.iter().take(8) {
+                let go = w.length_s() >= d;
+                let col = if go {
+                    c.settings.colours.go
+                } else {
+                    c.settings.colours.caution
+                };
+                lines.push(Line::from(Span::styled(fmt_window(w), Style::default().fg(col))));
+            }
+        }
+        _ => lines.push(Line::from(Span::styled(
+            "no current forecast",
+            Style::default().fg(c.settings.colours.no_go),
+        ))),
+    }
+    frame.render_widget(
+        Paragraph::new(lines).block(
+            Block::default()
+                .borders(Borders::ALL)
+                .title(format!(" Quiet windows ≥ {d:.0} s ")),
+        ),
+        win,
+    );
+    let lines: Vec<Line> = health_lines(c, now_wall_s)
+        .into_iter()
+        .map(|(s, t)| Line::from(Span::styled(t, Style::default().fg(colour(c, s)))))
+        .collect();
+    frame.render_widget(
+        Paragraph::new(lines)
+            .wrap(Wrap { trim: true })
+            .block(Block::default().borders(Borders::ALL).title(" Inputs ")),
+        health,
+    );
+}
+
+/// A tiny terminal: the verdict, each channel's numbers, the inputs, as text.
+fn draw_text(frame: &mut Frame, area: Rect, c: &Console, now_wall_s: f64) {
+    let (sev, text) = banner(c, now_wall_s);
+    let mut lines = vec![Line::from(Span::styled(text, Style::default().fg(colour(c, sev))))];
+    let d = c.settings.duration_s;
+    for ch in &c.settings.channels {
+        let fc = c.forecast_channel(ch);
+        let dt = c.forecast.as_ref().map_or(1.0, |f| f.dt_s);
+        let k = ((d / dt).ceil() as usize + 1).min(fc.len());
+        let max = fc[..k].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let now = fc.first().copied().unwrap_or(f64::NAN);
+        lines.push(Line::from(format!(
+            "{}: now {now:.2}, max {max:.2} next {d:.0} s, limit {} {}",
+            ch.name,
+            ch.limit,
+            ch.unit()
+        )));
+    }
+    for (s, t) in health_lines(c, now_wall_s) {
+        lines.push(Line::from(Span::styled(t, Style::default().fg(colour(c, s)))));
+    }
+    frame.render_widget(Paragraph::new(lines).wrap(Wrap { trim: true }), area);
+}
+
+fn draw_help(frame: &mut Frame, area: Rect) {
+    let w = 58.min(area.width);
+    let h = 14.min(area.height);
+    let r = Rect::new(area.x + (area.width - w) / 2, area.y + (area.height - h) / 2, w, h);
+    let text = vec![
+        Line::from("↑/↓ or k/j   choose a channel"),
+        Line::from("+ / -        raise / lower its limit by 10 %"),
+        Line::from("] / [        operation 10 s longer / shorter"),
+        Line::from("a            add a channel (vessel DOFs, points)"),
+        Line::from("x            remove the chosen channel"),
+        Line::from("? or h       this help; Esc closes it"),
+        Line::from("q            quit (the daemon keeps running)"),
+        Line::from(""),
+        Line::from("Grey trace: beyond the trusted horizon. Red lines:"),
+        Line::from("limits. Changes here last until the console quits;"),
+        Line::from("set defaults in [operation] of the config file."),
+    ];
+    frame.render_widget(Clear, r);
+    frame.render_widget(
+        Paragraph::new(text)
+            .alignment(Alignment::Left)
+            .block(Block::default().borders(Borders::ALL).title(" Keys ")),
+        r,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{forecast, two_vessels};
+    use super::*;
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    fn screen(c: &Console, w: u16, h: u16, now: f64) -> String {
+        let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
+        t.draw(|f| draw(f, c, now)).unwrap();
+        let b = t.backend().buffer();
+        (0..h)
+            .map(|y| (0..w).map(|x| b[(x, y)].symbol()).collect::<String>())
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    #[test]
+    fn banners_say_go_no_go_stale_and_stopped() {
+        let mut c = two_vessels();
+        assert!(banner(&c, 0.0).1.starts_with("Waiting for shipcast"));
+        c.on_forecast(forecast(120, 100.0, |_| 0.2, |_| 0.5));
+        assert_eq!(banner(&c, 5000.5).0, Severity::Ok);
+        assert!(
+            banner(&c, 5000.5)
+                .1
+                .starts_with("GO: every channel inside its limits for the next 100 s")
+        );
+        assert!(banner(&c, 5002.0).1.contains("NOT RESPONDING for 2 s"));
+        c.on_forecast(forecast(120, 100.0, |t| if t > 10.0 { 2.0 } else { 0.0 }, |_| 0.5));
+        let (s, t) = banner(&c, 5000.5);
+        assert_eq!(s, Severity::Alarm);
+        assert_eq!(
+            t,
+            "NO-GO: a.heave leaves its limit in 11 s; no 30 s window within the trusted 100 s"
+        );
+    }
+
+    #[test]
+    fn the_screen_shows_limits_horizon_windows_and_inputs() {
+        let mut c = two_vessels();
+        c.on_forecast(forecast(
+            120,
+            80.0,
+            |t| 0.5 * (t / 10.0).sin(),
+            |t| if t > 50.0 { 3.0 } else { 0.5 },
+        ));
+        for k in 0..600 {
+            let t = 940.0 + 0.1 * k as f64;
+            c.on_motion(0, t, &[0.0, 0.0, 0.4 * (t / 5.0).sin(), 0.0, 0.0, 0.0]);
+            c.on_motion(1, t, &[0.0; 6]);
+        }
+        let s = screen(&c, 120, 30, 5000.5);
+        assert!(
+            s.contains("GO: every channel inside its limits for the next 50 s"),
+            "{s}"
+        );
+        assert!(s.contains("▶ a.heave (m) limit ±1  · trusted 80 s"), "{s}");
+        assert!(s.contains("b.roll (deg) limit ±2  · trusted 80 s"), "{s}");
+        assert!(s.contains("Quiet windows ≥ 30 s"), "{s}");
+        assert!(s.contains("now, 50 s long"), "{s}");
+        assert!(s.contains("Trusted ahead: a 80 s"), "{s}");
+        assert!(
+            s.contains("-60 s") && s.contains("now") && s.contains("+60 s") && s.contains("+120 s"),
+            "{s}"
+        );
+        // a stale forecast is marked on every chart
+        let s = screen(&c, 120, 30, 5003.0);
+        assert!(s.contains("NOT RESPONDING") && s.matches("STALE").count() >= 3, "{s}");
+    }
+
+    /// The whole screen, compared with `src/console/snapshots/` (review a change with `cargo insta
+    /// review`, or accept it with `INSTA_UPDATE=always cargo test --lib console`).
+    #[test]
+    fn snapshot_of_a_no_go_screen() {
+        let mut c = two_vessels();
+        c.selected = 1;
+        c.on_forecast(forecast(
+            120,
+            60.0,
+            |t| 0.8 * (t / 8.0).sin(),
+            |t| if t < 15.0 { 2.5 } else { 1.0 },
+        ));
+        for k in 0..=60 {
+            let t = 940.0 + k as f64;
+            c.on_motion(0, t, &[0.0, 0.0, 0.6 * (t / 8.0).sin(), 0.0, 0.0, 0.0]);
+            c.on_motion(1, t, &[0.0, 0.0, 0.0, 0.04, 0.0, 0.0]);
+        }
+        insta::assert_snapshot!(screen(&c, 110, 28, 5000.4));
+    }
+
+    #[test]
+    fn a_tiny_terminal_gets_text() {
+        let mut c = two_vessels();
+        c.on_forecast(forecast(120, 100.0, |_| 0.2, |_| 0.5));
+        let s = screen(&c, 50, 10, 5000.5);
+        assert!(s.contains("GO: every"), "{s}");
+        assert!(s.contains("a.heave: now 0.20, max 0.20"), "{s}");
+        assert!(!s.contains('┌'), "{s}");
+    }
+
+    #[test]
+    fn help_shows_over_the_charts() {
+        let mut c = two_vessels();
+        c.help = true;
+        let s = screen(&c, 100, 30, 0.0);
+        assert!(s.contains(" Keys ") && s.contains("raise / lower its limit"), "{s}");
+    }
+}
