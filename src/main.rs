@@ -54,6 +54,8 @@ enum Command {
     Demo(cli::daemon::DemoArgs),
     /// A recorded log through the daemon's engine; with --report, skill against lead time.
     Replay(cli::replay::ReplayArgs),
+    /// External CSV recordings (motion, wave probes) written as a log for `replay`.
+    Import(cli::replay::ImportArgs),
 }
 
 #[derive(Args, Debug)]
@@ -253,6 +255,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Demo(args) => cli::daemon::demo(&args),
         Command::Console(_) => Ok(()),
         Command::Replay(args) => cli::replay::run(&args),
+        Command::Import(args) => cli::replay::import(&args),
     }
 }
 

@@ -69,6 +69,22 @@ impl Channel {
     }
 }
 
+impl Channel {
+    /// The trusted horizon of this channel from the vessels' horizons (a relative motion: the shorter
+    /// of its two vessels'), s.
+    pub fn horizon_s(&self, ext: &External, horizon_s: &[f64]) -> f64 {
+        let h = |b: usize| horizon_s.get(b).copied().unwrap_or(0.0);
+        match self.source {
+            Source::Dof { vessel, .. } => h(vessel),
+            Source::Point { point, .. } => ext.points.get(point).map_or(0.0, |p| h(p.body)),
+            Source::Relative { relative, .. } => ext
+                .relative_motions
+                .get(relative)
+                .map_or(0.0, |r| h(ext.points[r.a].body).min(h(ext.points[r.b].body))),
+        }
+    }
+}
+
 /// Resolves a channel name against the vessels' names and the system's points and relative motions.
 /// The error names what would have been accepted.
 pub fn resolve(name: &str, vessels: &[String], ext: &External) -> Result<Source, String> {
@@ -189,7 +205,8 @@ pub fn trusted_samples(n: usize, dt_s: f64, horizon_s: f64) -> usize {
     if !(horizon_s >= 0.0 && dt_s > 0.0) {
         return 0;
     }
-    (((horizon_s / dt_s) + 1e-9).floor() as usize + 1).min(n)
+    let k = (horizon_s / dt_s + 1e-9).floor();
+    if k >= n as f64 { n } else { k as usize + 1 }
 }
 
 /// Times where a series crosses its limit (|x| goes from inside to outside or back), linearly
@@ -310,6 +327,50 @@ pub fn score_windows(forecast: &[Window], actual: &[Window], duration_s: f64) ->
     s
 }
 
+/// One forecast's operator windows against the motion measured over its trusted span: channel values
+/// of the forecast (`forecast[s]`: series s, 6 per vessel, at t0 + k dt) and of the measurement
+/// (`measured[s]`: sorted (t, value) of series s), windows of each, matched by [`score_windows`]. None
+/// when the measurement does not cover the span.
+#[allow(clippy::too_many_arguments)]
+pub fn score_forecast_windows(
+    channels: &[Channel],
+    ext: &External,
+    t0_s: f64,
+    dt_s: f64,
+    forecast: &[&[f64]],
+    measured: &[Vec<(f64, f64)>],
+    trusted_s: f64,
+    duration_s: f64,
+) -> Option<WindowScore> {
+    let n = forecast.iter().map(|s| s.len()).min()?;
+    let m = trusted_samples(n, dt_s, trusted_s);
+    if m < 2 || measured.len() < forecast.len() {
+        return None;
+    }
+    let (mut xf, mut xm) = (vec![0.0; forecast.len()], vec![0.0; forecast.len()]);
+    let mut vf = vec![Vec::with_capacity(m); channels.len()];
+    let mut vm = vec![Vec::with_capacity(m); channels.len()];
+    for k in 0..m {
+        let t = t0_s + k as f64 * dt_s;
+        for s in 0..forecast.len() {
+            xf[s] = forecast[s][k];
+            xm[s] = crate::skill::interpolate(&measured[s], t)?;
+        }
+        for (c, ch) in channels.iter().enumerate() {
+            vf[c].push(ch.value(ext, &xf));
+            vm[c].push(ch.value(ext, &xm));
+        }
+    }
+    let limits: Vec<f64> = channels.iter().map(|c| c.limit).collect();
+    let view = |v: &[Vec<f64>]| -> Vec<bool> {
+        let refs: Vec<&[f64]> = v.iter().map(|x| x.as_slice()).collect();
+        inside(&refs, &limits)
+    };
+    let wf = windows(t0_s, dt_s, &view(&vf), duration_s);
+    let wm = windows(t0_s, dt_s, &view(&vm), duration_s);
+    Some(score_windows(&wf, &wm, duration_s))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -357,6 +418,8 @@ mod tests {
         assert_eq!(trusted_samples(1201, 0.1, 45.0), 451);
         assert_eq!(trusted_samples(1201, 0.1, 500.0), 1201);
         assert_eq!(trusted_samples(1201, 0.1, -1.0), 0);
+        assert_eq!(trusted_samples(1201, 0.1, f64::INFINITY), 1201);
+        assert_eq!(trusted_samples(1201, 0.1, f64::NAN), 0);
     }
 
     #[test]
@@ -396,5 +459,43 @@ mod tests {
         assert_eq!((s.good_calls, s.false_alarms), (1, 2));
         assert_eq!(s.detection_rate(), Some(1.0));
         assert!((s.false_alarm_ratio().unwrap() - 2.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_perfect_forecast_scores_hits_only_and_a_calm_one_false_alarms() {
+        let ch = [Channel {
+            name: "a.heave".into(),
+            source: Source::Dof { vessel: 0, dof: 2 },
+            limit: 1.0,
+        }];
+        let ext = External::default();
+        // heave bursts above 1 m between 40 and 60 s, quiet otherwise
+        let heave = |t: f64| if (40.0..60.0).contains(&t) { 1.5 } else { 0.3 };
+        let n = 121;
+        let series: Vec<Vec<f64>> = (0..6)
+            .map(|s| (0..n).map(|k| if s == 2 { heave(k as f64) } else { 0.0 }).collect())
+            .collect();
+        let measured: Vec<Vec<(f64, f64)>> = (0..6)
+            .map(|s| {
+                (0..=130)
+                    .map(|k| (k as f64, if s == 2 { heave(k as f64) } else { 0.0 }))
+                    .collect()
+            })
+            .collect();
+        let f: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
+        let s = score_forecast_windows(&ch, &ext, 0.0, 1.0, &f, &measured, 120.0, 30.0).unwrap();
+        assert_eq!((s.hits, s.misses, s.false_alarms, s.good_calls), (2, 0, 0, 2));
+        assert_eq!(s.timing_errors_s, vec![0.0, 0.0]);
+        let calm: Vec<Vec<f64>> = (0..6).map(|_| vec![0.0; n]).collect();
+        let f: Vec<&[f64]> = calm.iter().map(|s| s.as_slice()).collect();
+        let s = score_forecast_windows(&ch, &ext, 0.0, 1.0, &f, &measured, 120.0, 30.0).unwrap();
+        // one long forecast window over the whole span: it overlaps both real ones, and it held for
+        // its first 30 s (the burst comes at 40 s)
+        assert_eq!((s.hits, s.misses, s.false_alarms, s.good_calls), (2, 0, 0, 1));
+        // starting at 20 s the same calm call fails: the burst is inside its first 30 s
+        let s = score_forecast_windows(&ch, &ext, 20.0, 1.0, &f, &measured, 100.0, 30.0).unwrap();
+        assert_eq!((s.false_alarms, s.good_calls), (1, 0));
+        // no measurement beyond 130 s: a forecast reaching past it is not scored
+        assert!(score_forecast_windows(&ch, &ext, 20.0, 1.0, &f, &measured, 120.0, 30.0).is_none());
     }
 }

@@ -486,6 +486,23 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         assert_eq!(a.values.len(), b.values.len());
         assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
+    // the same check as a user runs it
+    let (ok, stdout, err) = crate::util::shipcast(&[
+        "replay",
+        logs[0].to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "--verify",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains(&format!(
+            "verify: {} recorded forecasts: {} identical bit for bit, 0 different, 0 not replayed",
+            live.len(),
+            live.len()
+        )),
+        "{stdout}"
+    );
 }
 
 #[test]

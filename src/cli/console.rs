@@ -19,6 +19,10 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 pub struct ConsoleArgs {
     #[arg(long, default_value = super::daemon::DEFAULT_CONFIG)]
     config: PathBuf,
+    /// Service prefix to subscribe under (default: the config's `ipc.service_prefix`; a replay
+    /// publishes under `<prefix>-replay`).
+    #[arg(long)]
+    prefix: Option<String>,
     /// Quit after this many seconds (scripted captures; default: until q).
     #[arg(long)]
     seconds: Option<f64>,
@@ -131,7 +135,7 @@ pub fn run(a: &ConsoleArgs) -> Result<()> {
     let (tx, rx) = mpsc::channel();
     let stop = Arc::new(AtomicBool::new(false));
     let names = Names {
-        prefix: cfg.ipc.service_prefix.clone(),
+        prefix: a.prefix.clone().unwrap_or_else(|| cfg.ipc.service_prefix.clone()),
     };
     let thread = {
         let stop = stop.clone();

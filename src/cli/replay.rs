@@ -3,6 +3,8 @@
 use super::daemon::{DEFAULT_CONFIG, load_config};
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
+use shipcast::operation::{Channel, WindowScore, score_forecast_windows};
 use shipcast::replay::{self, ForecastRecord, Record};
 use shipcast::skill::{self, SeriesForecast};
 use std::io::Write;
@@ -27,6 +29,19 @@ pub struct ReplayArgs {
     /// Write the replayed forecasts to this log.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Compare every forecast recorded in the log with its replay, bit for bit (a daemon's log);
+    /// fails if one differs or is missing.
+    #[arg(long)]
+    verify: bool,
+    /// Publish the replay over iceoryx2 (motion, forecasts, status) under this service prefix, for
+    /// a console (`shipcast console --prefix P`); default prefix `<ipc.service_prefix>-replay`. Use
+    /// with --speed.
+    #[arg(long, num_args = 0..=1, default_missing_value = "")]
+    publish: Option<String>,
+    /// With --report: also plot the forecast issued nearest this log time against what followed
+    /// (`forecast-<t>.svg`); repeatable. Default: the forecast in the middle of the log.
+    #[arg(long)]
+    at: Vec<f64>,
 }
 
 const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
@@ -47,8 +62,17 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         bail!("{}: no messages", a.log.display());
     };
     let (t_first, t_last) = (first.0, last.0);
+    let publisher = match &a.publish {
+        Some(p) => Some(Publisher::new(if p.is_empty() {
+            format!("{}-replay", cfg.ipc.service_prefix)
+        } else {
+            p.clone()
+        })?),
+        None => None,
+    };
     let wall = Instant::now();
     let mut forecasts: Vec<ForecastRecord> = vec![];
+    let mut published = 0usize;
     let counters = replay::drive(
         &cfg,
         &sys,
@@ -60,10 +84,28 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
                     std::thread::sleep(w);
                 }
             }
+            if let Some(p) = &publisher {
+                published = p.motion_until(&log.records, published, t);
+            }
         },
-        |h, v| forecasts.push(ForecastRecord::of(h, v)),
+        |o| match o {
+            Output::Forecast(h, v) => {
+                forecasts.push(ForecastRecord::of(&h, &v));
+                if let Some(p) = &publisher {
+                    let _ = p.out.send(Output::Forecast(h, v));
+                }
+            }
+            status => {
+                if let Some(p) = &publisher {
+                    let _ = p.out.send(status);
+                }
+            }
+        },
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(p) = publisher {
+        p.finish();
+    }
     let secs = wall.elapsed().as_secs_f64();
     let span_h = (t_last - t_first) / 3600.0;
     eprintln!(
@@ -86,8 +128,308 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     }
     if let Some(dir) = &a.report {
         report(dir, &sys, &log.records, &forecasts, cfg.forecast.horizon_s)?;
+        let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
+        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &a.config)?;
+        // windows are scored against the true motion when the log has it (a simulation), else the
+        // measured: IMU noise near a limit breaks windows that the motion itself kept
+        let truth = measured_series(&log.records, vessels.len(), true);
+        let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
+            (truth, "truth")
+        } else {
+            (measured_series(&log.records, vessels.len(), false), "measured")
+        };
+        windows_report(
+            dir,
+            &sys,
+            &channels,
+            cfg.operation.duration_s,
+            &forecasts,
+            &measured,
+            reference,
+        )?;
+        let ats = if a.at.is_empty() {
+            vec![(t_first + t_last) / 2.0]
+        } else {
+            a.at.clone()
+        };
+        for at in ats {
+            if let Some(f) = forecasts
+                .iter()
+                .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
+            {
+                let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s));
+                std::fs::write(&p, forecast_svg(f, &sys, &channels, &measured, reference))?;
+                println!("forecast against actual: {}", p.display());
+            }
+        }
+    }
+    if a.verify {
+        verify(&log.records, &forecasts)?;
     }
     Ok(())
+}
+
+/// The replay's iceoryx2 side: motion from the log as a sensor would send it, forecasts and status
+/// through the daemon's own output thread.
+struct Publisher {
+    sensor: SensorPublisher,
+    out: std::sync::mpsc::Sender<Output>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+impl Publisher {
+    fn new(prefix: String) -> Result<Publisher> {
+        let names = Names { prefix: prefix.clone() };
+        let sensor = SensorPublisher::new(&names).map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+        let (out, rx) = std::sync::mpsc::channel();
+        let (ready_tx, ready) = std::sync::mpsc::channel();
+        let thread = spawn_output(names, rx, ready_tx);
+        ready
+            .recv()
+            .context("the output thread ended")?
+            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
+        eprintln!("shipcast replay: publishing under \"{prefix}\" (watch: shipcast console --prefix {prefix})");
+        Ok(Publisher { sensor, out, thread })
+    }
+
+    /// Publishes the motion records from index `from` up to log time `t`; returns the next index.
+    fn motion_until(&self, records: &[(f64, Record)], from: usize, t: f64) -> usize {
+        let mut i = from;
+        while i < records.len() && records[i].0 <= t {
+            if let Record::Motion(m) = &records[i].1 {
+                let _ = self.sensor.motion(&m.to_wire());
+            }
+            i += 1;
+        }
+        i
+    }
+
+    fn finish(self) {
+        drop(self.out);
+        let _ = self.thread.join();
+    }
+}
+
+/// Every forecast recorded in the log against its replay (same issue time), bit for bit.
+fn verify(records: &[(f64, Record)], replayed: &[ForecastRecord]) -> Result<()> {
+    let recorded: Vec<&ForecastRecord> = records
+        .iter()
+        .filter_map(|(_, r)| match r {
+            Record::Forecast(f) => Some(f),
+            _ => None,
+        })
+        .collect();
+    if recorded.is_empty() {
+        bail!("--verify: the log holds no forecasts (record one with the daemon's [record] dir)");
+    }
+    let (mut same, mut differ, mut missing) = (0, 0, 0);
+    for r in &recorded {
+        match replayed
+            .iter()
+            .find(|b| b.issue_time_s.to_bits() == r.issue_time_s.to_bits())
+        {
+            None => missing += 1,
+            Some(b)
+                if b.flags == r.flags
+                    && b.values.len() == r.values.len()
+                    && b.values.iter().zip(&r.values).all(|(x, y)| x.to_bits() == y.to_bits()) =>
+            {
+                same += 1
+            }
+            Some(_) => differ += 1,
+        }
+    }
+    println!(
+        "verify: {} recorded forecasts: {same} identical bit for bit, {differ} different, {missing} not replayed ({} replayed in all)",
+        recorded.len(),
+        replayed.len()
+    );
+    if differ + missing > 0 {
+        bail!("--verify: {differ} forecasts differ and {missing} were not replayed");
+    }
+    Ok(())
+}
+
+/// Measured (or, with `truth`, true) (time, value) of every series (6 per vessel, m or rad), sorted
+/// by time.
+fn measured_series(records: &[(f64, Record)], n_vessels: usize, truth: bool) -> Vec<Vec<(f64, f64)>> {
+    let mut out = vec![vec![]; 6 * n_vessels];
+    for (_, r) in records {
+        let m = match (r, truth) {
+            (Record::Motion(m), false) | (Record::Truth(m), true) => m,
+            _ => continue,
+        };
+        if (m.vessel as usize) < n_vessels {
+            for d in 0..6 {
+                out[6 * m.vessel as usize + d].push((m.time_s, m.x[d]));
+            }
+        }
+    }
+    for s in &mut out {
+        s.sort_by(|a, b| a.0.total_cmp(&b.0));
+        s.dedup_by(|a, b| a.0 == b.0);
+    }
+    out
+}
+
+/// Operator windows forecast against those that happened (`[operation]` of the config), written into
+/// `windows.json` and summed up on stdout.
+fn windows_report(
+    dir: &Path,
+    sys: &shipcast::hydro::VesselSystem,
+    channels: &[Channel],
+    duration_s: f64,
+    forecasts: &[ForecastRecord],
+    measured: &[Vec<(f64, f64)>],
+    reference: &str,
+) -> Result<()> {
+    let ext = &sys.spec.external;
+    let mut total = WindowScore::default();
+    let mut scored = 0usize;
+    for f in forecasts {
+        let n = f.steps as usize + 1;
+        let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
+        let trusted = channels
+            .iter()
+            .map(|c| c.horizon_s(ext, &f.horizon_s))
+            .fold(f64::INFINITY, f64::min);
+        let s = score_forecast_windows(
+            channels,
+            ext,
+            f.issue_time_s,
+            f.dt_s,
+            &series,
+            measured,
+            trusted,
+            duration_s,
+        );
+        if let Some(s) = s {
+            total.add(&s);
+            scored += 1;
+        }
+    }
+    let te = &total.timing_errors_s;
+    let mean = (!te.is_empty()).then(|| te.iter().sum::<f64>() / te.len() as f64);
+    let mean_abs = (!te.is_empty()).then(|| te.iter().map(|x| x.abs()).sum::<f64>() / te.len() as f64);
+    let json = serde_json::json!({
+        "duration_s": duration_s,
+        "reference": reference,
+        "channels": channels.iter().map(|c| serde_json::json!({"name": c.name, "limit": c.limit, "unit": c.unit()})).collect::<Vec<_>>(),
+        "forecasts_scored": scored,
+        "windows_that_happened": total.hits + total.misses,
+        "hits": total.hits,
+        "misses": total.misses,
+        "forecast_windows": total.good_calls + total.false_alarms,
+        "false_alarms": total.false_alarms,
+        "detection_rate": total.detection_rate(),
+        "false_alarm_ratio": total.false_alarm_ratio(),
+        "timing_error_mean_s": mean,
+        "timing_error_mean_abs_s": mean_abs,
+        "definitions": "per forecast, over its trusted horizon: a window is every channel inside its limit for at least duration_s; a window that happened is detected when a forecast window overlaps it (timing error = forecast start - actual start); a forecast window is a false alarm when the motion left a limit within duration_s of its start",
+    });
+    std::fs::write(dir.join("windows.json"), serde_json::to_string_pretty(&json)? + "\n")?;
+    let pct = |x: Option<f64>| x.map_or("n/a".to_string(), |v| format!("{:.0} %", 100.0 * v));
+    println!(
+        "operator windows ({duration_s:.0} s, {} channels, {scored} forecasts, against the {reference} motion): detection {}, false alarms {}, timing error {} (mean abs): {}/windows.json",
+        channels.len(),
+        pct(total.detection_rate()),
+        pct(total.false_alarm_ratio()),
+        mean_abs.map_or("n/a".into(), |v| format!("{v:.1} s")),
+        dir.display()
+    );
+    Ok(())
+}
+
+/// One forecast against what followed, a panel per operation channel: measured (black), forecast
+/// (blue, dashed past the trusted horizon), limits (red). Hand-written SVG like [`svg`].
+fn forecast_svg(
+    f: &ForecastRecord,
+    sys: &shipcast::hydro::VesselSystem,
+    channels: &[Channel],
+    measured: &[Vec<(f64, f64)>],
+    reference: &str,
+) -> String {
+    let ext = &sys.spec.external;
+    let n = f.steps as usize + 1;
+    let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
+    let (w, ph, m) = (900.0, 200.0, 60.0);
+    let h = m + ph * channels.len() as f64 + 20.0;
+    let span = (n - 1) as f64 * f.dt_s;
+    let x = |t: f64| m + (w - 2.0 * m) * t / span.max(1.0);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{m}\" y=\"20\">forecast at {:.1} s (log time) against the {reference} motion: blue forecast (dashed past the trusted horizon), black {reference}, red limits</text>\n",
+        f.issue_time_s
+    );
+    let mut xs = vec![0.0; series.len()];
+    for (c, ch) in channels.iter().enumerate() {
+        let top = 40.0 + ph * c as f64;
+        let fc: Vec<f64> = (0..n)
+            .map(|k| {
+                for (xi, sr) in xs.iter_mut().zip(&series) {
+                    *xi = sr[k];
+                }
+                ch.value(ext, &xs)
+            })
+            .collect();
+        let meas: Vec<(f64, f64)> = (0..n)
+            .filter_map(|k| {
+                let t = f.issue_time_s + k as f64 * f.dt_s;
+                for (xi, sr) in xs.iter_mut().zip(measured) {
+                    *xi = skill::interpolate(sr, t)?;
+                }
+                Some((k as f64 * f.dt_s, ch.value(ext, &xs)))
+            })
+            .collect();
+        let peak = fc
+            .iter()
+            .chain(meas.iter().map(|p| &p.1))
+            .filter(|v| v.is_finite())
+            .fold(ch.limit * 1.2, |a, v| a.max(v.abs()));
+        let y = |v: f64| top + ph / 2.0 - (ph / 2.0 - 15.0) * v / peak;
+        let trusted = ch.horizon_s(ext, &f.horizon_s).min(span);
+        s.push_str(&format!(
+            "<text x=\"{m}\" y=\"{}\">{} ({}), limit ±{}, trusted {trusted:.0} s</text>\n",
+            top + 12.0,
+            ch.name,
+            ch.unit(),
+            ch.limit
+        ));
+        for l in [ch.limit, -ch.limit] {
+            s.push_str(&format!(
+                "<line x1=\"{m}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"red\"/>\n",
+                y(l),
+                w - m
+            ));
+        }
+        s.push_str(&format!(
+            "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#999\" stroke-dasharray=\"2,3\"/>\n",
+            x(trusted),
+            top + 15.0,
+            top + ph - 15.0
+        ));
+        let poly = |pts: &[(f64, f64)], style: &str| {
+            let p: Vec<String> = pts
+                .iter()
+                .filter(|(_, v)| v.is_finite())
+                .map(|(t, v)| format!("{:.1},{:.1}", x(*t), y(*v)))
+                .collect();
+            format!("<polyline fill=\"none\" {style} points=\"{}\"/>\n", p.join(" "))
+        };
+        let k_h = shipcast::operation::trusted_samples(n, f.dt_s, trusted);
+        let pts: Vec<(f64, f64)> = fc.iter().enumerate().map(|(k, v)| (k as f64 * f.dt_s, *v)).collect();
+        s.push_str(&poly(&meas, "stroke=\"black\" stroke-width=\"1.5\""));
+        s.push_str(&poly(&pts[..k_h], "stroke=\"#1f77b4\" stroke-width=\"2\""));
+        s.push_str(&poly(
+            &pts[k_h.saturating_sub(1)..],
+            "stroke=\"#1f77b4\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"",
+        ));
+    }
+    s.push_str(&format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">lead time 0 to {span:.0} s</text>\n</svg>\n",
+        w / 2.0,
+        h - 5.0
+    ));
+    s
 }
 
 /// Skill of every vessel DOF against lead time, against the measured motion in the log.
@@ -244,4 +586,82 @@ fn svg(lead: &[f64], curves: &[(String, Vec<f64>, Vec<f64>)]) -> String {
     }
     s.push_str("</svg>\n");
     s
+}
+
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// The log to write (MCAP).
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Motion CSV (layout: `src/replay/import.rs`); repeatable.
+    #[arg(long)]
+    motion: Vec<PathBuf>,
+    /// Wave-probe CSV; repeatable (each becomes a stream of fields).
+    #[arg(long)]
+    probe: Vec<PathBuf>,
+    /// Compass direction the waves travel to, for probe files without a towards_deg column.
+    #[arg(long)]
+    towards_deg: Option<f64>,
+    /// A field every this many seconds of a probe record.
+    #[arg(long, default_value_t = 2.0)]
+    probe_period: f64,
+    /// ... fitted to this many seconds of it.
+    #[arg(long, default_value_t = 120.0)]
+    probe_window: f64,
+    /// Frequencies kept from a probe record, rad/s.
+    #[arg(long, default_value = "0.25:1.6")]
+    band: String,
+}
+
+/// `shipcast import`: external CSV recordings written as a log that `shipcast replay` takes.
+pub fn import(a: &ImportArgs) -> Result<()> {
+    use shipcast::replay::import::{ProbeOptions, motion_csv, probe_csv, probe_fields};
+    let cfg = load_config(&a.config)?;
+    let sys = shipcast::files::load_system(&cfg.dir.join(&cfg.system.file))?.system;
+    let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
+    if a.motion.is_empty() && a.probe.is_empty() {
+        bail!("nothing to import: give --motion and/or --probe files");
+    }
+    let band = a
+        .band
+        .split_once(':')
+        .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
+        .with_context(|| format!("--band {}: expected MIN:MAX in rad/s", a.band))?;
+    for (name, v) in [("--probe-period", a.probe_period), ("--probe-window", a.probe_window)] {
+        if !(v.is_finite() && v > 0.0) {
+            bail!("{name} {v}: must be positive");
+        }
+    }
+    let read = |p: &Path| std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()));
+    let mut records: Vec<(f64, Record)> = vec![];
+    for p in &a.motion {
+        let m = motion_csv(&read(p)?, &p.display().to_string(), &vessels).map_err(|e| anyhow::anyhow!(e))?;
+        eprintln!("{}: {} motion samples", p.display(), m.len());
+        records.extend(m.into_iter().map(|r| (r.time_s, Record::Motion(r))));
+    }
+    let opts = ProbeOptions {
+        period_s: a.probe_period,
+        window_s: a.probe_window,
+        band_rad_s: band,
+        g_m_s2: sys.spec.g_m_s2,
+        depth_m: sys.spec.water_depth_m,
+        towards_deg: a.towards_deg,
+    };
+    for p in &a.probe {
+        let file = p.display().to_string();
+        let rec = probe_csv(&read(p)?, &file).map_err(|e| anyhow::anyhow!(e))?;
+        let f = probe_fields(&rec, &opts, &file).map_err(|e| anyhow::anyhow!(e))?;
+        eprintln!("{file}: {} samples, {} wave fields", rec.time_s.len(), f.len());
+        records.extend(f.into_iter().map(|w| (w.time_s, Record::Waves(w))));
+    }
+    records.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut rec = replay::Recorder::create(&a.out).map_err(|e| anyhow::anyhow!("{e}"))?;
+    for (t, r) in &records {
+        rec.record(*t, r).map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
+    println!("{}: {} messages", a.out.display(), records.len());
+    Ok(())
 }

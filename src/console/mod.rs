@@ -43,6 +43,21 @@ impl Default for Colours {
     }
 }
 
+impl Colours {
+    /// A dim palette for the bridge at night (keeps night vision: dark reds and ambers, no white).
+    pub fn night() -> Colours {
+        Colours {
+            measured: Color::Indexed(131),
+            forecast: Color::Indexed(166),
+            beyond_horizon: Color::Indexed(238),
+            limit: Color::Indexed(88),
+            go: Color::Indexed(94),
+            no_go: Color::Indexed(160),
+            caution: Color::Indexed(130),
+        }
+    }
+}
+
 /// The operator's settings: channels with limits, the operation's duration, how much past to show.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
@@ -134,19 +149,8 @@ pub struct Console {
     pub help: bool,
     /// A message to the operator about the last key (e.g. why a channel could not be added).
     pub note: Option<String>,
-}
-
-/// Trusted horizon, per channel, from the vessels' horizons.
-fn channel_horizon_s(c: &Channel, ext: &External, horizon_s: &[f64]) -> f64 {
-    let h = |b: usize| horizon_s.get(b).copied().unwrap_or(0.0);
-    match c.source {
-        Source::Dof { vessel, .. } => h(vessel),
-        Source::Point { point, .. } => ext.points.get(point).map_or(0.0, |p| h(p.body)),
-        Source::Relative { relative, .. } => ext
-            .relative_motions
-            .get(relative)
-            .map_or(0.0, |r| h(ext.points[r.a].body).min(h(ext.points[r.b].body))),
-    }
+    /// The other palette (the config's or the night one), swapped in by `n`.
+    other_colours: Colours,
 }
 
 /// What the forecast says for the operation, with the channel that decides it.
@@ -176,6 +180,7 @@ impl Console {
             selected: 0,
             help: false,
             note: None,
+            other_colours: Colours::night(),
         }
     }
 
@@ -281,7 +286,7 @@ impl Console {
     pub fn horizon_of(&self, c: &Channel) -> f64 {
         self.forecast
             .as_ref()
-            .map_or(0.0, |f| channel_horizon_s(c, &self.external, &f.horizon_s))
+            .map_or(0.0, |f| c.horizon_s(&self.external, &f.horizon_s))
     }
 
     /// The operation's outlook from the current forecast (None without a forecast or channels).
@@ -352,6 +357,10 @@ impl Console {
             Key::Char(']') => self.settings.duration_s += 10.0,
             Key::Char('[') => self.settings.duration_s = (self.settings.duration_s - 10.0).max(10.0),
             Key::Char('a') => self.add_channel(),
+            Key::Char('n') => {
+                std::mem::swap(&mut self.settings.colours, &mut self.other_colours);
+                self.note = Some("colours swapped (n again to swap back)".into());
+            }
             Key::Char('x') | Key::Char('d') if n > 1 => {
                 let c = self.settings.channels.remove(self.selected);
                 self.note = Some(format!("removed {}", c.name));
@@ -524,6 +533,10 @@ mod tests {
         assert_eq!(c.settings.channels[2].name, "a.surge");
         c.key(Key::Char('x'));
         assert_eq!(c.settings.channels.len(), 2);
+        c.key(Key::Char('n'));
+        assert_eq!(c.settings.colours, Colours::night());
+        c.key(Key::Char('n'));
+        assert_eq!(c.settings.colours, Colours::default());
         assert_eq!(c.key(Key::Char('?')), Action::None);
         assert!(c.help);
         assert_eq!(c.key(Key::Esc), Action::None);

@@ -256,7 +256,7 @@ pub fn draw(frame: &mut Frame, c: &Console, now_wall_s: f64) {
     let hint = c
         .note
         .clone()
-        .unwrap_or_else(|| "? help  ↑↓ channel  +/- limit  [/] duration  a add  x remove  q quit".into());
+        .unwrap_or_else(|| "? help  ↑↓ channel  +/- limit  [/] duration  a add  x remove  n night  q quit".into());
     frame.render_widget(Paragraph::new(hint).style(Style::default().fg(Color::Gray)), bottom);
     if c.help {
         draw_help(frame, area);
@@ -426,7 +426,7 @@ fn draw_text(frame: &mut Frame, area: Rect, c: &Console, now_wall_s: f64) {
 
 fn draw_help(frame: &mut Frame, area: Rect) {
     let w = 58.min(area.width);
-    let h = 14.min(area.height);
+    let h = 15.min(area.height);
     let r = Rect::new(area.x + (area.width - w) / 2, area.y + (area.height - h) / 2, w, h);
     let text = vec![
         Line::from("↑/↓ or k/j   choose a channel"),
@@ -434,6 +434,7 @@ fn draw_help(frame: &mut Frame, area: Rect) {
         Line::from("] / [        operation 10 s longer / shorter"),
         Line::from("a            add a channel (vessel DOFs, points)"),
         Line::from("x            remove the chosen channel"),
+        Line::from("n            night colours / the config's colours"),
         Line::from("? or h       this help; Esc closes it"),
         Line::from("q            quit (the daemon keeps running)"),
         Line::from(""),

@@ -87,7 +87,8 @@ pub struct WaveHeader {
     /// Reference point of the amplitudes, earth frame, m.
     pub ref_east_m: f64,
     pub ref_north_m: f64,
-    /// Radius of the observed disc around the reference point, m (0: unknown, treated as everywhere).
+    /// Radius of the observed disc around the reference point, m (0: unknown, treated as everywhere;
+    /// negative: a wave probe at the reference point).
     pub radius_m: f64,
     /// Water depth, m (0: infinite).
     pub depth_m: f64,

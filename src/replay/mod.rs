@@ -120,12 +120,18 @@ pub struct Recorder<W: Write + Seek> {
 pub struct RotatingRecorder {
     dir: std::path::PathBuf,
     rotate_bytes: u64,
+    /// Log seconds per file (None: by size only).
+    rotate_s: Option<f64>,
+    /// Log time of the current file's first message.
+    file_start_s: Option<f64>,
     index: u32,
     current: Option<Recorder<BufWriter<std::fs::File>>>,
 }
 
 impl RotatingRecorder {
-    pub fn new(dir: &Path, rotate_mb: f64) -> Result<Self, Error> {
+    /// Files `dir/shipcast-<unix time>-NNNN.mcap`, a new one past `rotate_mb` MB of messages or, when
+    /// given, `rotate_s` seconds of log time.
+    pub fn new(dir: &Path, rotate_mb: f64, rotate_s: Option<f64>) -> Result<Self, Error> {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let stamp = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
@@ -134,6 +140,8 @@ impl RotatingRecorder {
         let mut r = RotatingRecorder {
             dir: dir.join(format!("shipcast-{stamp}")),
             rotate_bytes: (rotate_mb * 1e6) as u64,
+            rotate_s,
+            file_start_s: None,
             index: 0,
             current: None,
         };
@@ -148,13 +156,27 @@ impl RotatingRecorder {
         Ok(())
     }
 
-    pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
-        if self.current.as_ref().is_some_and(|c| c.bytes > self.rotate_bytes)
+    /// Starts a new file if the current one is full or long enough (before a message at `time_s`).
+    fn rotate_if_due(&mut self, time_s: f64) -> Result<(), Error> {
+        let too_long = match (self.rotate_s, self.file_start_s) {
+            (Some(r), Some(t0)) => time_s - t0 >= r,
+            _ => false,
+        };
+        if (too_long || self.current.as_ref().is_some_and(|c| c.bytes > self.rotate_bytes))
             && let Some(c) = self.current.take()
         {
             c.finish()?;
             self.open()?;
+            self.file_start_s = None;
         }
+        if self.file_start_s.is_none() {
+            self.file_start_s = Some(time_s);
+        }
+        Ok(())
+    }
+
+    pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
+        self.rotate_if_due(time_s)?;
         match self.current.as_mut() {
             Some(c) => c.write(topic, time_s, msg),
             None => Ok(()),
@@ -163,12 +185,10 @@ impl RotatingRecorder {
 
     /// Writes a record on its channel.
     pub fn record(&mut self, t: f64, r: &Record) -> Result<(), Error> {
-        match r {
-            Record::Motion(m) => self.write("/motion", t, m),
-            Record::Waves(w) => self.write("/waves", t, w),
-            Record::Truth(m) => self.write("/truth", t, m),
-            Record::Forecast(f) => self.write("/forecast", t, f),
-            Record::Tick(k) => self.write("/tick", t, k),
+        self.rotate_if_due(t)?;
+        match self.current.as_mut() {
+            Some(c) => c.record(t, r),
+            None => Ok(()),
         }
     }
 
@@ -181,6 +201,8 @@ impl RotatingRecorder {
 }
 
 pub type Error = Box<dyn std::error::Error + Send + Sync>;
+
+pub mod import;
 
 const TOPICS: [(&str, &str); 5] = [
     ("/motion", "shipcast.Motion"),
@@ -223,6 +245,17 @@ impl<W: Write + Seek> Recorder<W> {
             seq: 0,
             bytes: 0,
         })
+    }
+
+    /// Writes a record on its channel.
+    pub fn record(&mut self, t: f64, r: &Record) -> Result<(), Error> {
+        match r {
+            Record::Motion(m) => self.write("/motion", t, m),
+            Record::Waves(w) => self.write("/waves", t, w),
+            Record::Truth(m) => self.write("/truth", t, m),
+            Record::Forecast(f) => self.write("/forecast", t, f),
+            Record::Tick(k) => self.write("/tick", t, k),
+        }
     }
 
     pub fn write<T: Serialize>(&mut self, topic: &'static str, time_s: f64, msg: &T) -> Result<(), Error> {
@@ -330,14 +363,14 @@ pub fn read(path: &Path) -> Result<Read, Error> {
 /// inline (no overruns: replay is not real time). A log recorded by the daemon carries its ticks
 /// (`/tick`, log time = the engine's clock): replay ticks exactly there and so takes every decision the
 /// live daemon took; a log without ticks (the simulator's) is ticked every `period_s` of log time.
-/// `on_forecast` sees every forecast; `pace` is called with each tick's log time (the shell sleeps
-/// there for `--speed`).
+/// `on_output` sees every forecast and every tick's status; `pace` is called with each tick's log time
+/// (the shell sleeps there for `--speed`, and publishes the inputs up to it).
 pub fn drive(
     cfg: &crate::service::config::ShipcastConfig,
     sys: &crate::hydro::VesselSystem,
     records: &[(f64, Record)],
     mut pace: impl FnMut(f64),
-    mut on_forecast: impl FnMut(&ForecastHeader, &[f64]),
+    mut on_output: impl FnMut(crate::ipc::Output),
 ) -> Result<crate::service::Counters, Error> {
     use crate::ipc::{Input, Output};
     use crate::service::{Computer, Engine, rom_options};
@@ -350,11 +383,11 @@ pub fn drive(
         pace(at);
         if let Some(job) = engine.tick(at) {
             let d = computer.run(job, || 0.0);
-            if let Some(Output::Forecast(h, v)) = engine.done(d) {
-                on_forecast(&h, &v);
+            if let Some(o @ Output::Forecast(..)) = engine.done(d) {
+                on_output(o);
             }
         }
-        let _ = engine.status(at, at, true);
+        on_output(Output::Status(engine.status(at, at, true)));
     };
     let recorded_ticks = records.iter().any(|(_, r)| matches!(r, Record::Tick(_)));
     for (t, r) in records {

@@ -126,6 +126,8 @@ pub struct RecordConfig {
     pub dir: String,
     /// A new file once the current one holds this many megabytes (uncompressed message bytes).
     pub rotate_mb: f64,
+    /// A new file every this many seconds of log time (default: by size only).
+    pub rotate_s: Option<f64>,
 }
 
 impl Default for RecordConfig {
@@ -133,6 +135,7 @@ impl Default for RecordConfig {
         RecordConfig {
             dir: String::new(),
             rotate_mb: 256.0,
+            rotate_s: None,
         }
     }
 }
@@ -478,6 +481,9 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             "record.rotate_mb".into(),
             format!("must be positive, found {}", c.record.rotate_mb),
         ));
+    }
+    if let Some(r) = c.record.rotate_s {
+        pos("record.rotate_s", r)?;
     }
     pos("operation.duration_s", c.operation.duration_s)?;
     for (i, ch) in c.operation.channels.iter().enumerate() {

@@ -472,7 +472,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
         None
     } else {
         let dir = cfg.dir.join(&cfg.record.dir);
-        match crate::replay::RotatingRecorder::new(&dir, cfg.record.rotate_mb) {
+        match crate::replay::RotatingRecorder::new(&dir, cfg.record.rotate_mb, cfg.record.rotate_s) {
             Ok(r) => Some(r),
             Err(e) => {
                 tracing::error!("recording disabled: {e}");

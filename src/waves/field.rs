@@ -57,8 +57,9 @@ pub struct WaveField {
 
 /// A field's header numbers in the flat layout shared by the wire (`ipc::wire::WaveHeader`) and the
 /// log (`replay::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
-/// Radius 0 = no region known (read back as [`Region::Everywhere`]; a probe's point travels as its
-/// reference point with radius 0); depth 0 = infinite.
+/// Radius 0 = no region known (read back as [`Region::Everywhere`]); a negative radius = a wave probe
+/// at the reference point ([`Region::Point`]; a probe's field is referred to its point); depth 0 =
+/// infinite.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlatHeader {
     pub time_s: f64,
@@ -101,14 +102,16 @@ impl WaveField {
     }
 
     /// Checks every component: positive finite frequency, finite direction and amplitude.
-    /// The header numbers of the flat layout ([`FlatHeader`]).
+    /// The header numbers of the flat layout ([`FlatHeader`]). A point region travels as the
+    /// reference point (a probe's field is referred to its probe: `observe::from_probe`).
     pub fn flat_header(&self) -> FlatHeader {
         FlatHeader {
             time_s: self.time_s,
             reference_m: self.reference_m,
             radius_m: match self.region {
                 Region::Disc { radius_m, .. } => radius_m,
-                _ => 0.0,
+                Region::Point { .. } => -1.0,
+                Region::Everywhere => 0.0,
             },
             depth_m: self.depth_m.unwrap_or(0.0),
             g_m_s2: self.g_m_s2,
