@@ -374,3 +374,34 @@ fn csv_recordings_import_and_replay_without_code() {
         "{err}"
     );
 }
+
+#[test]
+fn a_replay_publishes_for_a_console() {
+    use shipcast::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
+    use std::time::{Duration, Instant};
+    let dir = scratch_dir("replay-publish");
+    let (cfg, log) = simulated_log(&dir, 150);
+    let prefix = format!("shipcast-test-{}-replay-publish", std::process::id());
+    let names = Names { prefix: prefix.clone() };
+    let fs = ForecastSubscriber::new(&names).unwrap();
+    let ms = MotionSubscriber::new(&names).unwrap();
+    let _replay = shipcast::process::Interrupting(
+        std::process::Command::new(env!("CARGO_BIN_EXE_shipcast"))
+            .args(["replay", log.to_str().unwrap(), "--config", cfg.to_str().unwrap()])
+            .args(["--speed", "10", "--publish", &prefix])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let (mut got, mut motion) = (vec![], vec![]);
+    let t = Instant::now();
+    let forecasts = |g: &Vec<Received>| g.iter().filter(|r| matches!(r, Received::Forecast(..))).count();
+    while t.elapsed() < Duration::from_secs(30) && (forecasts(&got) < 5 || motion.is_empty()) {
+        fs.wait(Duration::from_millis(200), &mut got).unwrap();
+        ms.drain(&mut motion).unwrap();
+    }
+    assert!(forecasts(&got) >= 5, "{} forecasts", forecasts(&got));
+    assert!(got.iter().any(|r| matches!(r, Received::Status(s) if s.running == 1)));
+    assert!(!motion.is_empty());
+}

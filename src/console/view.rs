@@ -365,7 +365,9 @@ fn draw_side(frame: &mut Frame, area: Rect, c: &Console, now_wall_s: f64) {
             if o.windows.is_empty() {
                 lines.push(Line::from(format!("none in the trusted {:.0} s", o.trusted_s)));
             }
-            for w in o.windows.iter().take(8) {
+            // an open-ended window of a few seconds at the horizon's edge says nothing yet
+            let shown = o.windows.iter().filter(|w| !w.open_end || w.length_s() >= d.min(10.0));
+            for w in shown.take(8) {
                 let go = w.length_s() >= d;
                 let col = if go {
                     c.settings.colours.go
