@@ -13,8 +13,10 @@ use std::time::{Duration, Instant};
 
 #[derive(Args, Debug)]
 pub struct ReplayArgs {
-    /// The log (MCAP), e.g. from `shipcast simulate --record`.
-    log: PathBuf,
+    /// The log (MCAP), e.g. from `shipcast simulate --record`; several files (a rotated recording)
+    /// are replayed as one.
+    #[arg(required = true)]
+    log: Vec<PathBuf>,
     #[arg(long, default_value = DEFAULT_CONFIG)]
     config: PathBuf,
     /// Log seconds per wall second (default: as fast as possible).
@@ -54,12 +56,26 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     {
         bail!("--speed {s}: must be positive");
     }
-    let log = replay::read(&a.log).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // several files: a recording rotated by the daemon, replayed as one, the files in the order of
+    // their first message (each file's own order is kept: it is the order the daemon saw)
+    let mut parts = vec![];
+    for p in &a.log {
+        parts.push(replay::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
+    }
+    parts.sort_by(|x, y| {
+        let first = |r: &replay::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
+        first(x).total_cmp(&first(y))
+    });
+    let mut log = replay::Read { records: vec![], warnings: vec![] };
+    for part in parts {
+        log.records.extend(part.records);
+        log.warnings.extend(part.warnings);
+    }
     for w in &log.warnings {
         eprintln!("shipcast replay: warning: {w}");
     }
     let (Some(first), Some(last)) = (log.records.first(), log.records.last()) else {
-        bail!("{}: no messages", a.log.display());
+        bail!("{}: no messages", a.log[0].display());
     };
     let (t_first, t_last) = (first.0, last.0);
     let publisher = match &a.publish {
