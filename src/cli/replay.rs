@@ -40,8 +40,9 @@ pub struct ReplayArgs {
     /// with --speed.
     #[arg(long, num_args = 0..=1, default_missing_value = "")]
     publish: Option<String>,
-    /// With --report: also plot the forecast issued nearest this log time against what followed
-    /// (`forecast-<t>.svg`); repeatable. Default: the forecast in the middle of the log.
+    /// With --report: also plot the forecast issued nearest this time (the sensors' clock, as
+    /// forecasts' issue times) against what followed (`forecast-<t>.svg`); repeatable. Default: the
+    /// middle forecast of the log.
     #[arg(long)]
     at: Vec<f64>,
 }
@@ -66,7 +67,10 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         let first = |r: &replay::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
         first(x).total_cmp(&first(y))
     });
-    let mut log = replay::Read { records: vec![], warnings: vec![] };
+    let mut log = replay::Read {
+        records: vec![],
+        warnings: vec![],
+    };
     for part in parts {
         log.records.extend(part.records);
         log.warnings.extend(part.warnings);
@@ -123,16 +127,24 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         p.finish();
     }
     let secs = wall.elapsed().as_secs_f64();
-    let span_h = (t_last - t_first) / 3600.0;
+    // the sensors' clock: what was simulated or measured (a daemon's log time is its own clock, which
+    // runs slower than the data when the simulator ran faster than real time)
+    let data_times = log.records.iter().filter_map(|(_, r)| match r {
+        Record::Motion(m) => Some(m.time_s),
+        _ => None,
+    });
+    let (d0, d1) = data_times.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
+    let data_s = if d1 > d0 { d1 - d0 } else { t_last - t_first };
     eprintln!(
-        "shipcast replay: {} messages over {:.1} s of log, {} forecasts ({} samples, {} dropped) in {:.1} s: {:.2} log hours per wall minute",
+        "shipcast replay: {} messages over {:.1} s of log ({:.1} s of sensor data), {} forecasts ({} samples, {} dropped) in {:.1} s: {:.2} data hours per wall minute",
         log.records.len(),
         t_last - t_first,
+        data_s,
         forecasts.len(),
         counters.samples,
         counters.nonfinite + counters.late + counters.duplicate,
         secs,
-        span_h / (secs / 60.0)
+        data_s / 3600.0 / (secs / 60.0)
     );
     if let Some(p) = &a.out {
         let mut rec = replay::Recorder::create(p).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -163,8 +175,13 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
             &measured,
             reference,
         )?;
+        // issue times are on the sensors' clock; default: the middle forecast
         let ats = if a.at.is_empty() {
-            vec![(t_first + t_last) / 2.0]
+            forecasts
+                .get(forecasts.len() / 2)
+                .map(|f| f.issue_time_s)
+                .into_iter()
+                .collect()
         } else {
             a.at.clone()
         };
@@ -373,7 +390,7 @@ fn forecast_svg(
     let span = (n - 1) as f64 * f.dt_s;
     let x = |t: f64| m + (w - 2.0 * m) * t / span.max(1.0);
     let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{m}\" y=\"20\">forecast at {:.1} s (log time) against the {reference} motion: blue forecast (dashed past the trusted horizon), black {reference}, red limits</text>\n",
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{m}\" y=\"20\">forecast issued at {:.1} s against the {reference} motion: blue forecast (dashed: past the trusted horizon), red limits</text>\n",
         f.issue_time_s
     );
     let mut xs = vec![0.0; series.len()];
