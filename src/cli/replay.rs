@@ -475,6 +475,7 @@ fn report(
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let nb = sys.spec.bodies.len();
+    let measured_all = measured_series(records, nb, false);
     let step = 5.0;
     let mut json_vessels = vec![];
     let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,count\n");
@@ -484,13 +485,7 @@ fn report(
         let name = &sys.spec.bodies[b].name;
         let mut dofs = vec![];
         for (d, dof) in DOFS.iter().enumerate() {
-            let measured: Vec<(f64, f64)> = records
-                .iter()
-                .filter_map(|(_, r)| match r {
-                    Record::Motion(m) if m.vessel as usize == b => Some((m.time_s, m.x[d])),
-                    _ => None,
-                })
-                .collect();
+            let measured = &measured_all[6 * b + d];
             let fs: Vec<SeriesForecast> = forecasts
                 .iter()
                 .map(|f| {
@@ -503,7 +498,7 @@ fn report(
                     }
                 })
                 .collect();
-            let sk = skill::score(&fs, &measured, step, horizon_s);
+            let sk = skill::score(&fs, measured, step, horizon_s);
             lead = sk.lead_s.clone();
             let arr = |v: &[f64]| {
                 v.iter()
