@@ -146,6 +146,8 @@ impl WaveField {
                     centre_m: h.reference_m,
                     radius_m: h.radius_m,
                 }
+            } else if h.radius_m < 0.0 {
+                Region::Point { at_m: h.reference_m }
             } else {
                 Region::Everywhere
             },
@@ -314,6 +316,22 @@ mod tests {
             g_m_s2: 9.81,
             depth_m: Some(60.0),
             region: Region::Everywhere,
+        }
+    }
+
+    #[test]
+    fn the_flat_layout_keeps_every_region() {
+        for region in [
+            Region::Everywhere,
+            Region::Disc {
+                centre_m: [100.0, -50.0],
+                radius_m: 800.0,
+            },
+            Region::Point { at_m: [100.0, -50.0] },
+        ] {
+            let f = WaveField { region, ..field() };
+            let back = WaveField::from_flat(f.flat_header(), f.flat_rows()).unwrap();
+            assert_eq!(back, f);
         }
     }
 
