@@ -85,6 +85,31 @@ impl Channel {
     }
 }
 
+impl Channel {
+    /// The channel along a forecast: `series[s][k]` is series s (6 per vessel, m or rad) at sample k;
+    /// as many values as the shortest series.
+    pub fn along<S: AsRef<[f64]>>(&self, ext: &External, series: &[S]) -> Vec<f64> {
+        let n = series.iter().map(|s| s.as_ref().len()).min().unwrap_or(0);
+        let mut x = vec![0.0; series.len()];
+        (0..n)
+            .map(|k| {
+                for (xi, s) in x.iter_mut().zip(series) {
+                    *xi = s.as_ref()[k];
+                }
+                self.value(ext, &x)
+            })
+            .collect()
+    }
+}
+
+/// The span a set of channels is trusted over: the shortest of their horizons (infinite for none).
+pub fn trusted_horizon_s(channels: &[Channel], ext: &External, horizon_s: &[f64]) -> f64 {
+    channels
+        .iter()
+        .map(|c| c.horizon_s(ext, horizon_s))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Resolves a channel name against the vessels' names and the system's points and relative motions.
 /// The error names what would have been accepted.
 pub fn resolve(name: &str, vessels: &[String], ext: &External) -> Result<Source, String> {
@@ -347,17 +372,16 @@ pub fn score_forecast_windows(
     if m < 2 || measured.len() < forecast.len() {
         return None;
     }
-    let (mut xf, mut xm) = (vec![0.0; forecast.len()], vec![0.0; forecast.len()]);
-    let mut vf = vec![Vec::with_capacity(m); channels.len()];
+    let span: Vec<&[f64]> = forecast.iter().map(|s| &s[..m]).collect();
+    let vf: Vec<Vec<f64>> = channels.iter().map(|ch| ch.along(ext, &span)).collect();
+    let mut xm = vec![0.0; forecast.len()];
     let mut vm = vec![Vec::with_capacity(m); channels.len()];
     for k in 0..m {
         let t = t0_s + k as f64 * dt_s;
         for s in 0..forecast.len() {
-            xf[s] = forecast[s][k];
             xm[s] = crate::skill::interpolate(&measured[s], t)?;
         }
         for (c, ch) in channels.iter().enumerate() {
-            vf[c].push(ch.value(ext, &xf));
             vm[c].push(ch.value(ext, &xm));
         }
     }

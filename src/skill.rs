@@ -117,16 +117,20 @@ mod tests {
         let perfect: Vec<Vec<f64>> = (0..20)
             .map(|j| (0..=300).map(|k| truth(10.0 * j as f64 + k as f64 * 0.1)).collect())
             .collect();
-        let fs: Vec<SeriesForecast> = perfect
-            .iter()
-            .enumerate()
-            .map(|(j, v)| SeriesForecast {
-                t0_s: 10.0 * j as f64,
-                dt_s: 0.1,
-                values: v,
-            })
-            .collect();
-        let s = score(&fs, &measured, 5.0, 30.0);
+        // forecasts issued every 10 s at dt 0.1 s
+        let score_all = |runs: &[Vec<f64>]| {
+            let fs: Vec<SeriesForecast> = runs
+                .iter()
+                .enumerate()
+                .map(|(j, v)| SeriesForecast {
+                    t0_s: 10.0 * j as f64,
+                    dt_s: 0.1,
+                    values: v,
+                })
+                .collect();
+            score(&fs, &measured, 5.0, 30.0)
+        };
+        let s = score_all(&perfect);
         assert_eq!(s.lead_s.len(), 7);
         for l in 0..7 {
             assert!((s.correlation[l] - 1.0).abs() < 1e-4, "{:?}", s.correlation);
@@ -143,16 +147,7 @@ mod tests {
                     .collect()
             })
             .collect();
-        let fs: Vec<SeriesForecast> = drift
-            .iter()
-            .enumerate()
-            .map(|(j, v)| SeriesForecast {
-                t0_s: 10.0 * j as f64,
-                dt_s: 0.1,
-                values: v,
-            })
-            .collect();
-        let s = score(&fs, &measured, 5.0, 30.0);
+        let s = score_all(&drift);
         assert!(s.correlation[0] > 0.999 && s.correlation[6] < s.correlation[1]);
         assert!(s.nrmse[6] > s.nrmse[1]);
     }

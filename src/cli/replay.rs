@@ -322,10 +322,7 @@ fn windows_report(
     for f in forecasts {
         let n = f.steps as usize + 1;
         let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
-        let trusted = channels
-            .iter()
-            .map(|c| c.horizon_s(ext, &f.horizon_s))
-            .fold(f64::INFINITY, f64::min);
+        let trusted = shipcast::operation::trusted_horizon_s(channels, ext, &f.horizon_s);
         let s = score_forecast_windows(
             channels,
             ext,
@@ -396,14 +393,7 @@ fn forecast_svg(
     let mut xs = vec![0.0; series.len()];
     for (c, ch) in channels.iter().enumerate() {
         let top = 40.0 + ph * c as f64;
-        let fc: Vec<f64> = (0..n)
-            .map(|k| {
-                for (xi, sr) in xs.iter_mut().zip(&series) {
-                    *xi = sr[k];
-                }
-                ch.value(ext, &xs)
-            })
-            .collect();
+        let fc = ch.along(ext, &series);
         let meas: Vec<(f64, f64)> = (0..n)
             .filter_map(|k| {
                 let t = f.issue_time_s + k as f64 * f.dt_s;

@@ -255,17 +255,9 @@ impl Console {
 
     /// Channel `c` of the forecast, sample by sample.
     pub fn forecast_channel(&self, c: &Channel) -> Vec<f64> {
-        let Some(f) = &self.forecast else { return vec![] };
-        let n = f.x.iter().map(|s| s.len()).min().unwrap_or(0);
-        let mut x = vec![0.0; f.x.len()];
-        (0..n)
-            .map(|k| {
-                for (xi, s) in x.iter_mut().zip(&f.x) {
-                    *xi = s[k];
-                }
-                c.value(&self.external, &x)
-            })
-            .collect()
+        self.forecast
+            .as_ref()
+            .map_or_else(Vec::new, |f| c.along(&self.external, &f.x))
     }
 
     /// Channel `c` as measured: (time relative to `t0_s`, value) from `from_s` on.
@@ -297,7 +289,7 @@ impl Console {
             return None;
         }
         let series: Vec<Vec<f64>> = chans.iter().map(|c| self.forecast_channel(c)).collect();
-        let trusted_s = chans.iter().map(|c| self.horizon_of(c)).fold(f64::INFINITY, f64::min);
+        let trusted_s = operation::trusted_horizon_s(chans, &self.external, &f.horizon_s);
         let n = series.iter().map(|s| s.len()).min().unwrap_or(0);
         let m = operation::trusted_samples(n, f.dt_s, trusted_s);
         let views: Vec<&[f64]> = series.iter().map(|s| &s[..m]).collect();
