@@ -423,16 +423,27 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     let t_fit = std::time::Instant::now();
     // as the time-domain model fits it: against Ogilvie's A_inf (consistent with the damping)
     let a_inf_og = radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, &report.irf));
-    let (ss, eb, ea) = check::state_space(sys, &a_inf_og);
-    writeln!(
-        out,
-        "state-space radiation (active DOFs): {} terms ({} states before the rank-one reduction), fitted in {:.2} s; damping error {:.3} %, added mass error {:.3} % (largest, scaled)",
-        ss.terms.len(),
-        ss.n_states(),
-        t_fit.elapsed().as_secs_f64(),
-        100.0 * eb,
-        100.0 * ea
-    )?;
+    match check::state_space(sys, &a_inf_og) {
+        Ok((ss, eb, ea)) => {
+            let n_hsv = ss.hankel.len().min(ss.real_order() + 1);
+            writeln!(
+                out,
+                "state-space radiation (active DOFs): vector fit with {} pole pairs (largest scaled error {:.3} %), {} states balanced-truncated to {} ({} modes; next Hankel singular value {:.2e} of {:.2e}), fitted in {:.2} s; damping error {:.3} %, added mass error {:.3} % (largest, scaled); passivity cover {:.4} % of the peak damping",
+                ss.fit_pairs,
+                100.0 * ss.fit_error,
+                ss.full_order,
+                ss.real_order(),
+                ss.modes(),
+                ss.hankel.get(n_hsv.saturating_sub(1)).copied().unwrap_or(0.0),
+                ss.hankel.first().copied().unwrap_or(0.0),
+                t_fit.elapsed().as_secs_f64(),
+                100.0 * eb,
+                100.0 * ea,
+                100.0 * ss.cover
+            )?;
+        }
+        Err(e) => writeln!(out, "state-space radiation: no fit: {}", e.0)?,
+    }
     let mut warnings = sys.warnings.clone();
     for (i, ws) in &report.negative_damping {
         let peak = db.damping.iter().map(|b| b[(*i, *i)]).fold(0.0, f64::max);

@@ -1,8 +1,8 @@
 //! Database checks behind `shipcast db check` (pure): natural periods, negative damping, the
 //! Kramers-Kronig consistency of A(w), B(w) and A_inf.
 
+use super::modal;
 use super::radiation::{self, Irf, PairError};
-use super::statespace;
 use super::system::AInfSource;
 use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
@@ -56,16 +56,11 @@ pub fn active_radiation(
 
 /// The state-space fit of the active DOFs' radiation as the time-domain model makes it (damping and
 /// added mass fitted, A_inf given), and its (damping, added mass) errors.
-pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> (statespace::SsModel, f64, f64) {
+pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
     let (b, a, ai) = active_radiation(sys, a_inf);
-    let model = statespace::fit_with_added_mass(
-        &sys.db.omega_rad_s,
-        &b,
-        Some((&a, &ai)),
-        statespace::SsFitOptions::default(),
-    );
-    let (eb, ea) = statespace::fit_errors(&model, &sys.db.omega_rad_s, &b, &a, &ai);
-    (model, eb, ea)
+    let model = modal::fit(&sys.db.omega_rad_s, &b, &a, &ai, modal::ModalOptions::default())?;
+    let (eb, ea) = modal::fit_errors(&model, &sys.db.omega_rad_s, &b, &a, &ai);
+    Ok((model, eb, ea))
 }
 
 /// The IRF of a system with its configured (or default) time grid.

@@ -17,8 +17,8 @@
 pub mod check;
 pub mod db;
 pub mod external;
+pub mod modal;
 pub mod radiation;
-pub mod statespace;
 pub mod system;
 pub mod wamit;
 

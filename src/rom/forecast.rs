@@ -3,6 +3,7 @@
 
 use super::memory::Memory;
 use super::model::{Kernel, TimeModel};
+use super::sinusoids::Sinusoids;
 use super::stepper::Stepper;
 use super::{Error, Result};
 use crate::waves::{WaveComponent, encounter_frequency, wave_number};
@@ -58,13 +59,10 @@ pub struct Forecaster {
     out: Forecast,
     force: Vec<f64>,
     known: Vec<f64>,
-    // wave recurrence, laid out for vectorization over components
-    cr: Vec<f64>,
-    ci: Vec<f64>,
-    zr: Vec<f64>,
-    zi: Vec<f64>,
-    rr: Vec<f64>,
-    ri: Vec<f64>,
+    // the wave force as a sum of sinusoids: radians per step and complex amplitudes, output-major
+    sums: Sinusoids,
+    x_rad: Vec<f64>,
+    q: Vec<Complex64>,
     xbuf: Vec<Complex64>,
     kept_we: Vec<f64>,
     kept_x: Vec<Complex64>,
@@ -156,12 +154,9 @@ impl Forecaster {
             out: Forecast::default(),
             force: vec![],
             known: vec![],
-            cr: vec![],
-            ci: vec![],
-            zr: vec![],
-            zi: vec![],
-            rr: vec![],
-            ri: vec![],
+            sums: Sinusoids::new(),
+            x_rad: vec![],
+            q: vec![],
             xbuf: vec![],
             kept_we: vec![],
             kept_x: vec![],
@@ -306,12 +301,6 @@ impl Forecaster {
         let n = model.n();
         let dt = model.opts.dt_s;
         let u = model.opts.speed_m_s;
-        self.cr.clear();
-        self.ci.clear();
-        self.zr.clear();
-        self.zi.clear();
-        self.rr.clear();
-        self.ri.clear();
         self.xbuf.resize(model.n_modes, Complex64::default());
         self.kept_we.clear();
         self.kept_x.clear();
@@ -348,38 +337,26 @@ impl Forecaster {
         }
         self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
         let nc = self.kept_we.len();
-        self.cr.resize(n * nc, 0.0);
-        self.ci.resize(n * nc, 0.0);
+        self.x_rad.clear();
+        self.x_rad.extend(self.kept_we.iter().map(|we| we * dt));
+        self.q.clear();
+        self.q.resize(n * nc, Complex64::default());
         for c in 0..nc {
-            let we = self.kept_we[c];
             for i in 0..n {
-                self.cr[i * nc + c] = self.kept_x[c * n + i].re;
-                self.ci[i * nc + c] = self.kept_x[c * n + i].im;
+                self.q[i * nc + c] = self.kept_x[c * n + i];
             }
-            self.zr.push(1.0);
-            self.zi.push(0.0);
-            let (s, co) = (we * dt).sin_cos();
-            self.rr.push(co);
-            self.ri.push(s);
         }
         self.force.clear();
         self.force.resize((steps + 1) * n, 0.0);
-        for k in 0..=steps {
-            let t = k as f64 * dt;
-            let ramp = if ramp_s > 0.0 && t < ramp_s {
-                0.5 * (1.0 - (std::f64::consts::PI * t / ramp_s).cos())
-            } else {
-                1.0
-            };
-            for i in 0..n {
-                let cr = &self.cr[i * nc..(i + 1) * nc];
-                let ci = &self.ci[i * nc..(i + 1) * nc];
-                self.force[k * n + i] = ramp * (super::stepper::dot(cr, &self.zr) - super::stepper::dot(ci, &self.zi));
-            }
-            for c in 0..nc {
-                let (zr, zi) = (self.zr[c], self.zi[c]);
-                self.zr[c] = zr * self.rr[c] - zi * self.ri[c];
-                self.zi[c] = zr * self.ri[c] + zi * self.rr[c];
+        self.sums.real_sum(&self.x_rad, &self.q, n, steps + 1, &mut self.force);
+        if ramp_s > 0.0 {
+            for k in 0..=steps {
+                let t = k as f64 * dt;
+                if t >= ramp_s {
+                    break;
+                }
+                let ramp = 0.5 * (1.0 - (std::f64::consts::PI * t / ramp_s).cos());
+                self.force[k * n..(k + 1) * n].iter_mut().for_each(|f| *f *= ramp);
             }
         }
         Ok(())

@@ -5,7 +5,7 @@
 //! sample with [`Memory::push`] (the daemon does this as measurements arrive, once per sample) or from a
 //! whole history with [`Memory::from_history`].
 
-use super::model::{Channel, Kernel, TimeModel};
+use super::model::{Kernel, TimeModel};
 use super::{Error, Result};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +17,10 @@ pub enum Memory {
         len: usize,
     },
     StateSpace {
-        /// For term k and DOF j, `order_k` states, concatenated term by term, DOF by DOF.
+        /// The modes' states after the newest sample: r real parts, then r imaginary parts.
         states: Vec<f64>,
+        /// The modes' input b . v of the newest sample, laid out as `states`.
+        beta: Vec<f64>,
         last_v: Vec<f64>,
         started: bool,
     },
@@ -34,8 +36,9 @@ impl Memory {
                 head: 0,
                 len: 0,
             },
-            Kernel::StateSpace { channels, .. } => Memory::StateSpace {
-                states: vec![0.0; channels.iter().map(|c| c.disc.order).sum::<usize>()],
+            Kernel::StateSpace { step, .. } => Memory::StateSpace {
+                states: vec![0.0; 2 * step.r],
+                beta: vec![0.0; 2 * step.r],
                 last_v: vec![0.0; n],
                 started: false,
             },
@@ -73,13 +76,21 @@ impl Memory {
             (
                 Memory::StateSpace {
                     states,
+                    beta,
                     last_v,
                     started,
                 },
-                Kernel::StateSpace { channels, .. },
+                Kernel::StateSpace { step, .. },
             ) => {
+                let r = step.r;
+                let (xr, xi) = states.split_at_mut(r);
+                let (br, bi) = beta.split_at_mut(r);
                 if *started {
-                    advance_states(channels, states, last_v, v);
+                    step.propagate(xr, xi, br, bi);
+                }
+                step.input(v, br, bi);
+                if *started {
+                    step.absorb(xr, xi, br, bi);
                 }
                 last_v.copy_from_slice(v);
                 *started = true;
@@ -109,32 +120,5 @@ impl Memory {
                 }
             }
         }
-    }
-}
-
-/// Exact first-order-hold update of one channel's states over a step, input w0 -> w1.
-#[inline]
-pub(crate) fn update_channel(d: &crate::hydro::statespace::DiscreteTerm, x: &mut [f64], w0: f64, w1: f64) {
-    let m = d.order;
-    let mut tmp = [0.0f64; 8];
-    for r in 0..m {
-        let mut acc = d.gamma0[r] * w0 + d.gamma1[r] * w1;
-        for c in 0..m {
-            acc += d.phi[r * m + c] * x[c];
-        }
-        tmp[r] = acc;
-    }
-    x.copy_from_slice(&tmp[..m]);
-}
-
-/// Exact first-order-hold update of every channel's states from velocity `v0` to `v1` over one step.
-pub(crate) fn advance_states(channels: &[Channel], states: &mut [f64], v0: &[f64], v1: &[f64]) {
-    let mut off = 0;
-    for ch in channels {
-        let m = ch.disc.order;
-        let w0: f64 = ch.u.iter().zip(v0).map(|(a, b)| a * b).sum();
-        let w1: f64 = ch.u.iter().zip(v1).map(|(a, b)| a * b).sum();
-        update_channel(&ch.disc, &mut states[off..off + m], w0, w1);
-        off += m;
     }
 }

@@ -22,14 +22,18 @@
 //! lines and fenders are nonlinear forces relative to their equilibrium value.
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
-//! reference) or the passive state-space fit ([`crate::hydro::statespace`]) with its exact discrete
-//! update.
+//! reference) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced truncation,
+//! passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
+//! over the horizon, is evaluated by a non-uniform FFT when the field has many components
+//! ([`sinusoids`]).
 
 pub mod forecast;
 pub mod memory;
+pub mod modal;
 pub mod model;
 pub mod outputs;
 pub mod regular;
+pub mod sinusoids;
 pub mod stepper;
 
 pub use forecast::{Forecast, ForecastRequest, Forecaster};

@@ -1,9 +1,10 @@
 //! The assembled time-domain model of a vessel system over its active DOFs (pure).
 
+use super::modal::ModalStep;
 use super::{Error, Result};
 use crate::hydro::check::active_radiation;
+use crate::hydro::modal::{self, ModalModel, ModalOptions};
 use crate::hydro::radiation::{self, default_duration_s};
-use crate::hydro::statespace::{self, DiscreteTerm, SsFitOptions, SsModel};
 use crate::hydro::system::AInfSource;
 use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
@@ -56,22 +57,11 @@ impl Default for RomOptions {
 pub enum Kernel {
     /// `k[(i * taps + m) * n + j] = dt w_m K_m(i, j)`, trapezoid weights w_0 = w_last = 1/2.
     Convolution { taps: usize, k: Vec<f64> },
-    /// The fitted model realized as rank-one channels (see [`Channel`]).
-    StateSpace { model: SsModel, channels: Vec<Channel> },
-}
-
-/// One rank-one piece of a state-space term: G_k = sum of lambda u u^T over its eigenvectors, so the
-/// term's force is sum over channels of u y, y = H_k(s) (u . v) with u scaled by sqrt(lambda). A channel
-/// has one scalar input and `order` states; eigenvalues below [`CHANNEL_CUTOFF`] of the largest are
-/// dropped (what is kept is still PSD: passivity holds).
-#[derive(Debug, Clone)]
-pub struct Channel {
-    pub disc: DiscreteTerm,
-    pub u: Vec<f64>,
-    /// c . Phi (row), c . gamma0, c . gamma1.
-    pub c_phi: Vec<f64>,
-    pub c_g0: f64,
-    pub c_g1: f64,
+    /// The fitted modal model and its exact discrete update at the solver's step.
+    StateSpace {
+        model: Box<ModalModel>,
+        step: Box<ModalStep>,
+    },
 }
 
 /// Scratch for [`TimeModel::nonlinear_force`].
@@ -81,9 +71,6 @@ pub struct NlScratch {
     v: Vec<f64>,
     f: Vec<f64>,
 }
-
-/// Eigenvalues of a term's gain below this fraction of the model's largest (scaled) are dropped.
-pub const CHANNEL_CUTOFF: f64 = 1e-4;
 
 /// Time-domain model over the active DOFs. Matrices are n x n with n = number of active DOFs, in the
 /// order of `active` (global 0-based mode indices).
@@ -117,6 +104,10 @@ pub struct TimeModel {
     pub d_inst: DMatrix<f64>,
     /// [M + dt/2 (B + D) + beta dt^2 C]^-1.
     pub s_inv: DMatrix<f64>,
+    /// The step's matrices row-major for its inner loop: B + D, C, S^-1.
+    pub rows_bd: Vec<f64>,
+    pub rows_c: Vec<f64>,
+    pub rows_s_inv: Vec<f64>,
     /// The database (for the excitation), with the system's g and depth.
     pub db: HydroDb,
     pub g_m_s2: f64,
@@ -202,63 +193,24 @@ impl TimeModel {
             }
             RadiationMethod::StateSpace => {
                 let (b, a_act, a_inf_act) = active_radiation(sys, &a_inf_all);
-                let model = statespace::fit_with_added_mass(
+                let model = modal::fit(
                     &sys.db.omega_rad_s,
                     &b,
-                    Some((&a_act, &a_inf_act)),
-                    SsFitOptions {
+                    &a_act,
+                    &a_inf_act,
+                    ModalOptions {
                         tolerance: opts.ss_tolerance,
-                        ..SsFitOptions::default()
+                        ..ModalOptions::default()
                     },
-                );
-                // rank-one channels, in coordinates scaled by sqrt(max_w B_ii) so units do not matter
-                let scale: Vec<f64> = radiation::diagonal_peaks(&b).into_iter().map(f64::sqrt).collect();
-                let eigs: Vec<_> = model
-                    .terms
-                    .iter()
-                    .map(|t| DMatrix::from_fn(nh, nh, |i, j| t.gain[(i, j)] / (scale[i] * scale[j])).symmetric_eigen())
-                    .collect();
-                let top = eigs
-                    .iter()
-                    .flat_map(|e| e.eigenvalues.iter().copied())
-                    .fold(0.0, f64::max);
-                let mut channels = vec![];
+                )
+                .map_err(|e| Error::Input(format!("state-space radiation: {}", e.0)))?;
+                let step = ModalStep::new(&model, dt);
+                let di = step.instantaneous();
                 let mut d = DMatrix::zeros(n, n);
-                for (t, e) in model.terms.iter().zip(&eigs) {
-                    let disc = statespace::discretize(&t.shape, dt);
-                    let m = disc.order;
-                    let c_phi: Vec<f64> = (0..m)
-                        .map(|col| (0..m).map(|r| disc.c[r] * disc.phi[r * m + col]).sum())
-                        .collect();
-                    let c_g0: f64 = disc.c.iter().zip(&disc.gamma0).map(|(a, b)| a * b).sum();
-                    let c_g1: f64 = disc.c.iter().zip(&disc.gamma1).map(|(a, b)| a * b).sum();
-                    for (l, lam) in e.eigenvalues.iter().enumerate() {
-                        if *lam <= CHANNEL_CUTOFF * top {
-                            continue;
-                        }
-                        // tank states (after the nh hydrodynamic ones) do not radiate
-                        let u: Vec<f64> = (0..n)
-                            .map(|i| {
-                                if i < nh {
-                                    e.eigenvectors[(i, l)] * lam.sqrt() * scale[i]
-                                } else {
-                                    0.0
-                                }
-                            })
-                            .collect();
-                        for i in 0..n {
-                            for j in 0..n {
-                                d[(i, j)] += c_g1 * u[i] * u[j];
-                            }
-                        }
-                        channels.push(Channel {
-                            disc: disc.clone(),
-                            u,
-                            c_phi: c_phi.clone(),
-                            c_g0,
-                            c_g1,
-                        });
-                    }
+                d.view_mut((0, 0), (nh, nh)).copy_from(&di);
+                // passivity cover: constant damping where the fit's Re K dips below zero (see modal)
+                for i in 0..nh {
+                    damping[(i, i)] += model.cover * model.scale[i];
                 }
                 // A_inf consistent with this model's own kernel (Ogilvie with K_ss): its added mass then
                 // follows the database's, whatever tail the fit gives B beyond the data
@@ -273,7 +225,13 @@ impl TimeModel {
                 mass = sub(&terms.mass);
                 let mut top = mass.view_mut((0, 0), (nh, nh));
                 top += &a_inf_ss;
-                (Kernel::StateSpace { model, channels }, d)
+                (
+                    Kernel::StateSpace {
+                        model: Box::new(model),
+                        step: Box::new(step),
+                    },
+                    d,
+                )
             }
         };
         let s = &mass + (&damping + &d_inst) * (dt / 2.0) + &stiffness * (opts.beta * dt * dt);
@@ -312,7 +270,15 @@ impl TimeModel {
             .iter()
             .map(|&i| crate::hydro::check::mode_label(sys, i))
             .collect();
+        let (rows_bd, rows_c, rows_s_inv) = (
+            row_major(&(&damping + &d_inst)),
+            row_major(&stiffness),
+            row_major(&s_inv),
+        );
         Ok(TimeModel {
+            rows_bd,
+            rows_c,
+            rows_s_inv,
             n_modes: sys.n_states(),
             n_hydro: nh,
             external,
@@ -434,7 +400,12 @@ impl TimeModel {
     pub fn memory_size(&self) -> usize {
         match &self.kernel {
             Kernel::Convolution { taps, .. } => *taps,
-            Kernel::StateSpace { channels, .. } => channels.iter().map(|c| c.disc.order).sum(),
+            Kernel::StateSpace { model, .. } => model.real_order(),
         }
     }
+}
+
+/// The entries of `m` row by row.
+fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+    m.transpose().as_slice().to_vec()
 }

@@ -2,7 +2,7 @@
 //! radiation force split into a known part and an implicit instantaneous part (see [`super`]).
 //! The stepper owns only reusable workspace; what it reads comes in as arguments.
 
-use super::memory::{Memory, advance_states, update_channel};
+use super::memory::Memory;
 use super::model::{Kernel, NlScratch, TimeModel};
 use super::{Error, Result};
 
@@ -22,8 +22,10 @@ pub struct Stepper {
     pub k: usize,
     /// Convolution: velocities in reverse time order; v_k at (capacity - k) n, history after v_0.
     buf: Vec<f64>,
-    /// State space: term states.
+    /// State space: the modes' states (r real parts, then r imaginary parts) and their input b . v at
+    /// the current step, laid out alike.
     states: Vec<f64>,
+    beta: Vec<f64>,
     // scratch
     xt: Vec<f64>,
     vt: Vec<f64>,
@@ -31,8 +33,6 @@ pub struct Stepper {
     p: Vec<f64>,
     fnl: Vec<f64>,
     a_new: Vec<f64>,
-    /// State space: each channel's input u . v at the current step.
-    w: Vec<f64>,
     v_new: Vec<f64>,
     v_pred: Vec<f64>,
     x_pred: Vec<f64>,
@@ -80,10 +80,9 @@ impl Stepper {
             }
             self.buf = vec![0.0; if taps > 0 { (steps + taps) * n } else { 0 }];
         }
-        if let Kernel::StateSpace { channels, .. } = &model.kernel {
-            self.states
-                .resize(channels.iter().map(|c| c.disc.order).sum::<usize>(), 0.0);
-            self.w.resize(channels.len(), 0.0);
+        if let Kernel::StateSpace { step, .. } = &model.kernel {
+            self.states.resize(2 * step.r, 0.0);
+            self.beta.resize(2 * step.r, 0.0);
         }
     }
 
@@ -137,35 +136,24 @@ impl Stepper {
                 }
             }
             (
-                Kernel::StateSpace { channels, .. },
+                Kernel::StateSpace { step, .. },
                 Memory::StateSpace {
-                    states,
-                    last_v,
-                    started,
+                    states, beta, started, ..
                 },
             ) => {
+                let r = step.r;
                 self.states.copy_from_slice(states);
+                self.beta.copy_from_slice(beta);
+                let (xr, xi) = self.states.split_at_mut(r);
+                let (br, bi) = self.beta.split_at_mut(r);
                 if *started {
-                    advance_states(channels, &mut self.states, last_v, v0);
+                    step.propagate(xr, xi, br, bi);
                 }
-                let mut off = 0;
-                for ch in channels {
-                    let m = ch.disc.order;
-                    let y: f64 = ch
-                        .disc
-                        .c
-                        .iter()
-                        .zip(&self.states[off..off + m])
-                        .map(|(c, x)| c * x)
-                        .sum();
-                    for (f, u) in frad.iter_mut().zip(&ch.u) {
-                        *f += u * y;
-                    }
-                    off += m;
+                step.input(v0, br, bi);
+                if *started {
+                    step.absorb(xr, xi, br, bi);
                 }
-                for (w, ch) in self.w.iter_mut().zip(channels) {
-                    *w = ch.u.iter().zip(v0).map(|(a, b)| a * b).sum();
-                }
+                step.output(xr, xi, &mut frad);
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
         }
@@ -207,23 +195,14 @@ impl Stepper {
                     self.p[i] = known[i] + dot(row, &self.buf[start..start + mcount * n]);
                 }
             }
-            Kernel::StateSpace { channels, .. } => {
+            Kernel::StateSpace { step, .. } => {
+                // the states with everything but the new input: E xi + g0 beta_k
                 self.p.iter_mut().for_each(|p| *p = 0.0);
-                let mut off = 0;
-                for (ch, &w) in channels.iter().zip(&self.w) {
-                    let m = ch.disc.order;
-                    let y: f64 = ch
-                        .c_phi
-                        .iter()
-                        .zip(&self.states[off..off + m])
-                        .map(|(c, x)| c * x)
-                        .sum::<f64>()
-                        + ch.c_g0 * w;
-                    for (p, u) in self.p.iter_mut().zip(&ch.u) {
-                        *p += u * y;
-                    }
-                    off += m;
-                }
+                let r = step.r;
+                let (xr, xi) = self.states.split_at_mut(r);
+                let (br, bi) = self.beta.split_at_mut(r);
+                step.propagate(xr, xi, br, bi);
+                step.output(xr, xi, &mut self.p);
             }
         }
         // predictor
@@ -248,16 +227,16 @@ impl Stepper {
                 model.nonlinear_force(&self.x_pred, &self.v_pred, &mut self.fnl, &mut self.nl);
             }
             for i in 0..n {
-                let mut r = f1[i] - self.p[i] - self.fnl[i];
-                for j in 0..n {
-                    r -= (model.damping[(i, j)] + model.d_inst[(i, j)]) * self.vt[j]
-                        + model.stiffness[(i, j)] * self.xt[j];
-                }
-                self.rhs[i] = r;
+                let row = i * n..(i + 1) * n;
+                self.rhs[i] = f1[i]
+                    - self.p[i]
+                    - self.fnl[i]
+                    - dot(&model.rows_bd[row.clone()], &self.vt)
+                    - dot(&model.rows_c[row], &self.xt);
             }
             let (mut change, mut size) = (0.0f64, 0.0f64);
             for i in 0..n {
-                let a: f64 = (0..n).map(|j| model.s_inv[(i, j)] * self.rhs[j]).sum();
+                let a = dot(&model.rows_s_inv[i * n..(i + 1) * n], &self.rhs);
                 change = change.max((a - self.a_new[i]).abs());
                 size = size.max(a.abs());
                 self.a_new[i] = a;
@@ -278,16 +257,12 @@ impl Stepper {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
             }
-            Kernel::StateSpace { channels, .. } => {
-                // each channel's input u . v, kept for the next step: one dot product per channel
-                let mut off = 0;
-                for (ch, w0) in channels.iter().zip(self.w.iter_mut()) {
-                    let m = ch.disc.order;
-                    let w1: f64 = ch.u.iter().zip(&self.v_new).map(|(a, b)| a * b).sum();
-                    update_channel(&ch.disc, &mut self.states[off..off + m], *w0, w1);
-                    *w0 = w1;
-                    off += m;
-                }
+            Kernel::StateSpace { step, .. } => {
+                let r = step.r;
+                let (xr, xi) = self.states.split_at_mut(r);
+                let (br, bi) = self.beta.split_at_mut(r);
+                step.input(&self.v_new, br, bi);
+                step.absorb(xr, xi, br, bi);
             }
         }
         std::mem::swap(&mut self.v, &mut self.v_new);
