@@ -1006,7 +1006,11 @@ mod tests {
                 }
             }
         }
-        eprintln!("known kernel: worst scaled error {worst:.2e}, {} modes, cover {}", m.modes(), m.cover);
+        eprintln!(
+            "known kernel: worst scaled error {worst:.2e}, {} modes, cover {}",
+            m.modes(),
+            m.cover
+        );
         assert!(worst < TOL, "worst scaled error {worst}, {} modes", m.modes());
         assert!(m.poles.iter().all(|p| p.re < 0.0));
         assert!(m.cover == 0.0, "passivity left to the cover: {}", m.cover);

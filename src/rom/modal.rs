@@ -8,6 +8,7 @@
 
 use crate::hydro::modal::ModalModel;
 use multiversion::multiversion;
+use multiversion::target::target_cfg_f;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -111,19 +112,37 @@ impl ModalStep {
 // The inner loops, compiled for AVX2 + FMA as well as the baseline and chosen at run time
 // (`multiversion`): they are most of a state-space forecast's time.
 
+/// Modes per block of the input and output kernels (two AVX registers of f64).
+const LANES: usize = 8;
+
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
-fn input_kernel(r: usize, n: usize, b_re: &[f64], b_im: &[f64], v: &[f64], re: &mut [f64], im: &mut [f64]) {
-    let (re, im) = (&mut re[..r], &mut im[..r]);
-    re.fill(0.0);
-    im.fill(0.0);
-    for (i, vi) in v.iter().enumerate().take(n) {
-        let (br, bi) = (&b_re[i * r..(i + 1) * r], &b_im[i * r..(i + 1) * r]);
-        for (x, b) in re.iter_mut().zip(br) {
-            *x += b * vi;
+fn input_kernel(r: usize, n: usize, a_re: &[f64], a_im: &[f64], v: &[f64], re: &mut [f64], im: &mut [f64]) {
+    // fused multiply-add where the selected target has it (a constant in each compiled version)
+    let fma = target_cfg_f!(target_feature = "fma");
+    let madd = |a: f64, b: f64, c: f64| if fma { a.mul_add(b, c) } else { a * b + c };
+    let (re, im, v) = (&mut re[..r], &mut im[..r], &v[..n]);
+    let full = r / LANES * LANES;
+    // a block of modes at a time, accumulated over the DOFs in registers
+    for j in (0..full).step_by(LANES) {
+        let (mut ar, mut ai) = ([0.0f64; LANES], [0.0f64; LANES]);
+        for (i, vi) in v.iter().enumerate() {
+            let (br, bi) = (&a_re[i * r + j..i * r + j + LANES], &a_im[i * r + j..i * r + j + LANES]);
+            for l in 0..LANES {
+                ar[l] = madd(br[l], *vi, ar[l]);
+                ai[l] = madd(bi[l], *vi, ai[l]);
+            }
         }
-        for (x, b) in im.iter_mut().zip(bi) {
-            *x += b * vi;
+        re[j..j + LANES].copy_from_slice(&ar);
+        im[j..j + LANES].copy_from_slice(&ai);
+    }
+    for j in full..r {
+        let (mut ar, mut ai) = (0.0, 0.0);
+        for (i, vi) in v.iter().enumerate() {
+            ar = madd(a_re[i * r + j], *vi, ar);
+            ai = madd(a_im[i * r + j], *vi, ai);
         }
+        re[j] = ar;
+        im[j] = ai;
     }
 }
 
@@ -160,24 +179,28 @@ fn absorb_kernel(r: usize, g_re: &[f64], g_im: &[f64], xr: &mut [f64], xi: &mut 
 }
 
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
-fn output_kernel(r: usize, n: usize, c_re: &[f64], c_im: &[f64], xr: &[f64], xi: &[f64], out: &mut [f64]) {
+fn output_kernel(r: usize, n: usize, a_re: &[f64], a_im: &[f64], xr: &[f64], xi: &[f64], out: &mut [f64]) {
+    let fma = target_cfg_f!(target_feature = "fma");
+    let madd = |a: f64, b: f64, c: f64| if fma { a.mul_add(b, c) } else { a * b + c };
     let (xr, xi) = (&xr[..r], &xi[..r]);
+    let full = r / LANES * LANES;
     for (i, f) in out.iter_mut().enumerate().take(n) {
-        let (cr, ci) = (&c_re[i * r..(i + 1) * r], &c_im[i * r..(i + 1) * r]);
-        let mut acc = [0.0f64; 8];
-        let chunks = cr
-            .chunks_exact(4)
-            .zip(xr.chunks_exact(4))
-            .zip(ci.chunks_exact(4).zip(xi.chunks_exact(4)));
-        for ((a, x), (b, y)) in chunks {
-            for l in 0..4 {
-                acc[l] += a[l] * x[l];
-                acc[4 + l] += b[l] * y[l];
+        let (ar, ai) = (&a_re[i * r..(i + 1) * r], &a_im[i * r..(i + 1) * r]);
+        // separate accumulators for the real and imaginary products: independent chains per lane
+        let (mut p, mut q) = ([0.0f64; LANES], [0.0f64; LANES]);
+        let blocks = ar[..full]
+            .chunks_exact(LANES)
+            .zip(xr[..full].chunks_exact(LANES))
+            .zip(ai[..full].chunks_exact(LANES).zip(xi[..full].chunks_exact(LANES)));
+        for ((a, x), (b, y)) in blocks {
+            for l in 0..LANES {
+                p[l] = madd(a[l], x[l], p[l]);
+                q[l] = madd(b[l], y[l], q[l]);
             }
         }
-        let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]) - ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-        for j in (r / 4) * 4..r {
-            s += cr[j] * xr[j] - ci[j] * xi[j];
+        let mut s = p.iter().sum::<f64>() - q.iter().sum::<f64>();
+        for j in full..r {
+            s += ar[j] * xr[j] - ai[j] * xi[j];
         }
         *f = s;
     }
