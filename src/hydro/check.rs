@@ -54,8 +54,8 @@ pub fn active_radiation(
     (b, sys.db.added_mass.iter().map(sub).collect(), sub(a_inf))
 }
 
-/// The state-space fit of the active DOFs' radiation as the time-domain model makes it (damping and
-/// added mass fitted, A_inf given), and its (damping, added mass) errors.
+/// The state-space fit of the active DOFs' radiation as the time-domain model makes it (see
+/// [`modal::fit`]), and its (damping, added mass) errors, the added mass against the given A_inf.
 pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
     let (b, a, ai) = active_radiation(sys, a_inf);
     let model = modal::fit(&sys.db.omega_rad_s, &b, &a, &ai, modal::ModalOptions::default())?;

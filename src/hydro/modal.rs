@@ -8,9 +8,15 @@
 //! 1. Scaling: every entry is divided by sqrt(s_i s_j), s_i = max_w B_ii, so that DOFs of different units
 //!    weigh alike and the peak of every diagonal is 1.
 //! 2. Vector fitting (Gustavsen & Semlyen 1999, relaxed: Gustavsen 2006; fast QR form: Deschrijver et al.
-//!    2008) of the upper triangle with one set of stable poles common to every entry: poles relocated as
-//!    the zeros of the weighting function, unstable ones reflected into the left half-plane, then the
-//!    residues by linear least squares. More pole pairs are tried until the fit meets the tolerance.
+//!    2008) of the upper triangle (symmetric part) with one set of stable poles common to every entry,
+//!    relocated as the zeros of the weighting function, unstable ones reflected into the left
+//!    half-plane, none narrower than half the local frequency spacing; then the residues by linear least
+//!    squares with K(0) = 0 exactly. The least-squares rows are real parts only: the database's damping,
+//!    B(0) = 0 and B linear below the data, the IRF's w^-3 tail above it (as the convolution sees B), so
+//!    the fit's added mass follows by causality from that damping; the added mass still enters the
+//!    pole relocation, where the weighting function multiplies the complex data K = B + i w (A - A_inf)
+//!    (with the imaginary part zeroed, the relocation diverged on the one-ship demo).
+//!    More pole pairs are tried until the fit meets the tolerance.
 //! 3. A real realization of the fit (per pole, one state per DOF and per real coordinate of the pole),
 //!    reduced by square-root balanced truncation (Gramians solved block by block, the controllability one
 //!    exactly as a Kronecker product): the kept order is the smallest whose error bound, twice the sum of
@@ -791,7 +797,7 @@ impl Realization {
             for q in 0..nb {
                 let (dp, dq) = (dims[p], dims[q]);
                 let op = sylvester_operator(&self.s[p].transpose(), &self.s[q]);
-                let Some(lu) = Some(op.lu()) else { continue };
+                let lu = op.lu();
                 for al in 0..n {
                     for be in 0..n {
                         let rhs = DVector::from_fn(dp * dq, |k, _| {

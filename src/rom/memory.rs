@@ -1,7 +1,7 @@
 //! Radiation memory state: what the model needs of the past velocities (pure).
 //!
 //! Convolution: the last `taps` velocity samples at the solver step (newest last). State space: the
-//! states of every term and DOF after the newest sample, and that sample. Either is built sample by
+//! modal states after the newest sample, their input then, and that sample. Either is built sample by
 //! sample with [`Memory::push`] (the daemon does this as measurements arrive, once per sample) or from a
 //! whole history with [`Memory::from_history`].
 

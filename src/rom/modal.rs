@@ -73,7 +73,7 @@ impl ModalStep {
         d
     }
 
-    /// beta = B v into (re, im).
+    /// beta = A^T v (the symmetric map `a`) into (re, im).
     pub fn input(&self, v: &[f64], re: &mut [f64], im: &mut [f64]) {
         input_kernel(self.r, self.n, &self.a_re, &self.a_im, v, re, im);
     }
@@ -88,12 +88,12 @@ impl ModalStep {
         absorb_kernel(self.r, &self.g1_re, &self.g1_im, xr, xi, br, bi);
     }
 
-    /// F = Re C xi into `out`.
+    /// F = Re A xi into `out` (the first n entries).
     pub fn output(&self, xr: &[f64], xi: &[f64], out: &mut [f64]) {
         output_kernel(self.r, self.n, &self.a_re, &self.a_im, xr, xi, out);
     }
 
-    /// The instantaneous matrix D = Re(C diag(g1) B): F_{k+1} = (known part) + D v_{k+1}.
+    /// The instantaneous matrix D = Re(A diag(g1) A^T): F_{k+1} = (known part) + D v_{k+1}.
     pub fn instantaneous(&self) -> DMatrix<f64> {
         let r = self.r;
         DMatrix::from_fn(self.n, self.n, |a, bb| {
