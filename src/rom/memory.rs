@@ -82,16 +82,7 @@ impl Memory {
                 },
                 Kernel::StateSpace { step, .. },
             ) => {
-                let r = step.r;
-                let (xr, xi) = states.split_at_mut(r);
-                let (br, bi) = beta.split_at_mut(r);
-                if *started {
-                    step.propagate(xr, xi, br, bi);
-                }
-                step.input(v, br, bi);
-                if *started {
-                    step.absorb(xr, xi, br, bi);
-                }
+                step.feed(states, beta, v, *started);
                 last_v.copy_from_slice(v);
                 *started = true;
             }

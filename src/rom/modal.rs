@@ -73,6 +73,21 @@ impl ModalStep {
         d
     }
 
+    /// Feeds the next velocity sample `v` to the states `x` (r real parts, then r imaginary parts) whose
+    /// input of the previous sample is `beta` (laid out alike): the whole update when `started`, else
+    /// only the input (a history at rest before `v`).
+    pub fn feed(&self, x: &mut [f64], beta: &mut [f64], v: &[f64], started: bool) {
+        let (xr, xi) = x.split_at_mut(self.r);
+        let (br, bi) = beta.split_at_mut(self.r);
+        if started {
+            self.propagate(xr, xi, br, bi);
+        }
+        self.input(v, br, bi);
+        if started {
+            self.absorb(xr, xi, br, bi);
+        }
+    }
+
     /// beta = A^T v (the symmetric map `a`) into (re, im).
     pub fn input(&self, v: &[f64], re: &mut [f64], im: &mut [f64]) {
         input_kernel(self.r, self.n, &self.a_re, &self.a_im, v, re, im);

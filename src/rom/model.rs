@@ -100,11 +100,8 @@ pub struct TimeModel {
     /// Number of active body DOFs: they come first in `active`, the tank states after them.
     pub n_hydro: usize,
     pub kernel: Kernel,
-    /// Instantaneous radiation matrix D: F_rad(t_k+1) = P + D v_k+1.
-    pub d_inst: DMatrix<f64>,
-    /// [M + dt/2 (B + D) + beta dt^2 C]^-1.
-    pub s_inv: DMatrix<f64>,
-    /// The step's matrices row-major for its inner loop: B + D, C, S^-1.
+    /// The step's matrices, row-major for its inner loop: B + D (D the instantaneous radiation matrix,
+    /// F_rad(t_k+1) = P + D v_k+1), C, and S^-1 = [M + dt/2 (B + D) + beta dt^2 C]^-1.
     pub rows_bd: Vec<f64>,
     pub rows_c: Vec<f64>,
     pub rows_s_inv: Vec<f64>,
@@ -283,8 +280,6 @@ impl TimeModel {
             stiffness,
             quadratic,
             kernel,
-            d_inst,
-            s_inv,
             db: sys.db.clone(),
             g_m_s2: sys.spec.g_m_s2,
             water_depth_m: sys.spec.water_depth_m,

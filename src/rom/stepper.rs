@@ -141,18 +141,10 @@ impl Stepper {
                     states, beta, started, ..
                 },
             ) => {
-                let r = step.r;
                 self.states.copy_from_slice(states);
                 self.beta.copy_from_slice(beta);
-                let (xr, xi) = self.states.split_at_mut(r);
-                let (br, bi) = self.beta.split_at_mut(r);
-                if *started {
-                    step.propagate(xr, xi, br, bi);
-                }
-                step.input(v0, br, bi);
-                if *started {
-                    step.absorb(xr, xi, br, bi);
-                }
+                step.feed(&mut self.states, &mut self.beta, v0, *started);
+                let (xr, xi) = self.states.split_at(step.r);
                 step.output(xr, xi, &mut frad);
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
