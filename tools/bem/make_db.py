@@ -149,6 +149,16 @@ PRESETS = {
         omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6001, 0.005)]), 4),
         headings_deg=np.arange(0.0, 360.0, 30.0),
     ),
+    # the pair to 2.2 rad/s (an experiment on the pair's Kramers-Kronig residual: is the lighter's yaw
+    # damping above 1.6 rad/s what its low-frequency added mass misses?)
+    "pair-wide": dict(
+        stem="pair",
+        bodies=None,  # the pair's
+        panel_m=3.0,
+        omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6, 0.005),
+                                        np.arange(1.6, 2.2001, 0.01)]), 4),
+        headings_deg=np.arange(0.0, 360.0, 30.0),
+    ),
     # a smoke test of this script (seconds)
     "box-test": dict(
         stem="box",
@@ -170,7 +180,9 @@ def main():
     ap.add_argument("--preset", choices=sorted(PRESETS), required=True)
     ap.add_argument("outdir")
     args = ap.parse_args()
-    p = PRESETS[args.preset]
+    p = dict(PRESETS[args.preset])
+    if p["bodies"] is None:
+        p["bodies"] = PRESETS["pair"]["bodies"]
     import os
     os.makedirs(args.outdir, exist_ok=True)
     t0 = time.time()
