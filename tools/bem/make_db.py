@@ -149,8 +149,11 @@ PRESETS = {
         omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6001, 0.005)]), 4),
         headings_deg=np.arange(0.0, 360.0, 30.0),
     ),
-    # the pair to 2.2 rad/s (an experiment on the pair's Kramers-Kronig residual: is the lighter's yaw
-    # damping above 1.6 rad/s what its low-frequency added mass misses?)
+    # the pair to 2.2 rad/s, an experiment on the pair's Kramers-Kronig residual (session 5, 450 s): the
+    # lighter's horizontal modes became consistent (yaw A 3.3 -> 0.74 %, Ogilvie spread 6.2 -> 1.3 %), so
+    # their residual is damping above 1.6 rad/s; but 3 m panels are too coarse there (carrier heave A
+    # 11 % off at 1.66 rad/s, negative lighter heave damping at 1.79): not a usable demo database. A
+    # finer mesh to 2.2 rad/s is the fix; its cost was not measured.
     "pair-wide": dict(
         stem="pair",
         bodies=None,  # the pair's
