@@ -162,6 +162,15 @@ PRESETS = {
                                         np.arange(1.6, 2.2001, 0.01)]), 4),
         headings_deg=np.arange(0.0, 360.0, 30.0),
     ),
+    # pair-wide on 2 m panels (an experiment: does the finer mesh keep the data to 2.2 rad/s consistent?)
+    "pair-fine": dict(
+        stem="pair",
+        bodies=None,  # the pair's
+        panel_m=2.0,
+        omegas=np.round(np.concatenate([np.arange(0.05, 0.8, 0.025), np.arange(0.8, 1.6, 0.005),
+                                        np.arange(1.6, 2.2001, 0.02)]), 4),
+        headings_deg=np.arange(0.0, 360.0, 30.0),
+    ),
     # a smoke test of this script (seconds)
     "box-test": dict(
         stem="box",
