@@ -5,20 +5,26 @@
 use shipcast::files::load_system;
 use shipcast::hydro::check::{choose_a_inf, system_irf};
 use shipcast::hydro::radiation::{kramers_kronig, ogilvie_a_inf, ogilvie_estimates};
+use shipcast::hydro::system::TailChoice;
 use shipcast::hydro::{Dof, VesselSystem};
 
 use crate::util::repo;
 
-/// With Ogilvie's A_inf, every pair of every database: measured worst 1.12 % (RM3, float surge);
+/// With Ogilvie's A_inf, every pair of every database: measured worst 1.14 % (RM3, float surge);
 /// the rest is the modelled damping tail beyond the database's last frequency.
 const KK_TOL_OGILVIE: f64 = 0.015;
 /// Heave, roll and pitch pairs with the BEM's own A_inf: measured worst 2.7 % (RM3 spar roll and pitch;
-/// its heave 0.52 %), 1.06 % on the demos (lighter heave); these modes carry restoring.
+/// its heave 0.52 %), 0.94 % on the demos (lighter heave); these modes carry restoring.
 const KK_TOL_VERTICAL_DB_A_INF: f64 = 0.03;
-/// Every pair with the BEM's own A_inf: measured worst 5.6 % (RM3 float roll-sway, where WAMIT's A_inf is
-/// offset from its own A(w) by a constant: Ogilvie's estimate removes it), 3.3 % on the demos (the
-/// 120 m lighter's yaw and surge still radiate at 1.6 rad/s, where the database ends).
+/// Every pair with the BEM's own A_inf on WEC-Sim's RM3: measured worst 5.6 % (float roll-sway, where
+/// WAMIT's A_inf is offset from its own A(w) by a constant: Ogilvie's estimate removes it).
 const KK_TOL_ANY_DB_A_INF: f64 = 0.06;
+/// Every pair with the BEM's own A_inf on the demos (symmetrized, with the fitted damping tail):
+/// measured worst 1.15 % (pair: lighter heave - carrier sway at the 0.965 rad/s gap resonance), 0.44 %
+/// (ship). With the cubic tail the pair was 3.3 % (the lighter's yaw, still radiating at 1.6 rad/s).
+const KK_TOL_DEMO_DB_A_INF: f64 = 0.015;
+/// The pair's lighter yaw with the cubic tail: measured 3.3 %; with the fitted tail 0.19 %.
+const KK_LIGHTER_YAW_FITTED: f64 = 0.005;
 
 fn load(rel: &str) -> VesselSystem {
     load_system(&repo(rel)).unwrap().system
@@ -28,7 +34,7 @@ fn vertical(i: usize) -> bool {
     matches!(Dof::of_index(i), Dof::Heave | Dof::Roll | Dof::Pitch)
 }
 
-fn check(rel: &str) {
+fn check(rel: &str, tol_any_db: f64) {
     let sys = load(rel);
     let irf = system_irf(&sys);
     let (a_inf, _) = choose_a_inf(&sys, &irf);
@@ -47,23 +53,43 @@ fn check(rel: &str) {
     let ogw = worst(&with_og, &|_, _| true);
     eprintln!("{rel}: KK worst in band: vertical {vert:.4}, any {any:.4} (database A_inf), any {ogw:.4} (Ogilvie)");
     assert!(vert <= KK_TOL_VERTICAL_DB_A_INF, "{rel}: vertical {vert}");
-    assert!(any <= KK_TOL_ANY_DB_A_INF, "{rel}: any {any}");
+    assert!(any <= tol_any_db, "{rel}: any {any}");
     assert!(ogw <= KK_TOL_OGILVIE, "{rel}: Ogilvie {ogw}");
 }
 
 #[test]
 fn capytaine_one_ship_is_kramers_kronig_consistent() {
-    check("config/vessels/ship/system.toml");
+    check("config/vessels/ship/system.toml", KK_TOL_DEMO_DB_A_INF);
 }
 
 #[test]
 fn capytaine_two_ships_are_kramers_kronig_consistent() {
-    check("config/vessels/pair/system.toml");
+    check("config/vessels/pair/system.toml", KK_TOL_DEMO_DB_A_INF);
 }
 
 #[test]
 fn wamit_rm3_is_kramers_kronig_consistent() {
-    check("tests/data/wecsim-rm3/system.toml");
+    check("tests/data/wecsim-rm3/system.toml", KK_TOL_ANY_DB_A_INF);
+}
+
+/// The pair database ends at 1.6 rad/s where the 120 m lighter still radiates in yaw: the cubic tail
+/// leaves its added mass 3.3 % off across the band; the tail fitted to the database's A(w) and A_inf
+/// restores it (and the test can fail: with the cubic tail it does).
+#[test]
+fn the_fitted_tail_makes_the_pair_consistent() {
+    let mut sys = load("config/vessels/pair/system.toml");
+    let yaw = |sys: &VesselSystem| {
+        let irf = system_irf(sys);
+        let (a_inf, _) = choose_a_inf(sys, &irf);
+        let e = kramers_kronig(&sys.db, &irf, &a_inf);
+        e.iter().find(|e| e.i == 11 && e.j == 11).unwrap().added_mass_band
+    };
+    let fitted = yaw(&sys);
+    sys.spec.irf.tail = TailChoice::Cubic;
+    let cubic = yaw(&sys);
+    eprintln!("pair lighter yaw KK in band: cubic tail {cubic:.4}, fitted {fitted:.4}");
+    assert!(fitted <= KK_LIGHTER_YAW_FITTED, "fitted {fitted}");
+    assert!(cubic > KK_LIGHTER_YAW_FITTED, "cubic {cubic}");
 }
 
 #[test]

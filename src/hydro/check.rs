@@ -2,8 +2,8 @@
 //! Kramers-Kronig consistency of A(w), B(w) and A_inf.
 
 use super::modal;
-use super::radiation::{self, Irf, PairError};
-use super::system::AInfSource;
+use super::radiation::{self, DampingTail, Irf, PairError};
+use super::system::{AInfSource, TailChoice};
 use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
@@ -19,10 +19,31 @@ pub struct CheckReport {
     pub a_inf: DMatrix<f64>,
     pub a_inf_source: AInfSource,
     pub irf: Irf,
+    pub tail: DampingTail,
+    /// The tail fit's worst added-mass residual in band (cubic, fitted), when fitted.
+    pub tail_fit_residuals: Option<(f64, f64)>,
     /// Kramers-Kronig errors per DOF pair with the A_inf used (see [`radiation::kramers_kronig`]).
     pub kk: Vec<PairError>,
     /// The same with Ogilvie's A_inf, for comparison.
     pub kk_ogilvie: Vec<PairError>,
+    /// Largest asymmetry of A(w) and of B(w): max |X_ij - X_ji| / sqrt(max|X_ii| max|X_jj|) (reciprocity
+    /// makes both symmetric; a panel method's are not, by its discretization error).
+    pub asymmetry_added_mass: f64,
+    pub asymmetry_damping: f64,
+}
+
+/// max over w and i, j of |X_ij - X_ji| / sqrt(max_w |X_ii| max_w |X_jj|).
+pub fn asymmetry(ms: &[DMatrix<f64>]) -> f64 {
+    let peaks = radiation::diagonal_peaks(ms);
+    let mut worst = 0.0f64;
+    for m in ms {
+        for i in 0..m.nrows() {
+            for j in 0..i {
+                worst = worst.max((m[(i, j)] - m[(j, i)]).abs() / (peaks[i] * peaks[j]).sqrt());
+            }
+        }
+    }
+    worst
 }
 
 /// Chooses A_inf as the system file asks: the database's when present (unless told otherwise), else
@@ -42,35 +63,101 @@ pub fn choose_a_inf(sys: &VesselSystem, irf: &Irf) -> (DMatrix<f64>, AInfSource)
     }
 }
 
-/// The active DOFs' passive damping, added mass and A_inf (the inputs of the radiation models).
-pub fn active_radiation(
-    sys: &VesselSystem,
-    a_inf: &DMatrix<f64>,
-) -> (Vec<DMatrix<f64>>, Vec<DMatrix<f64>>, DMatrix<f64>) {
+/// The radiation memory the time-domain models use: K(t) on t = 0, dt, ..., duration from the
+/// database's damping made passive and the damping tail the system file asks for (fitted to the BEM's
+/// A_inf unless `irf.tail = "cubic"` or the database has none).
+#[derive(Debug, Clone)]
+pub struct Memory {
+    pub irf: Irf,
+    pub tail: DampingTail,
+    /// The fit's worst added-mass residual in band (cubic tail, fitted tail), when fitted.
+    pub fit_residuals: Option<(f64, f64)>,
+}
+
+pub fn memory(sys: &VesselSystem, dt_s: f64, duration_s: f64) -> Memory {
+    let (b, _) = radiation::passive_damping(&sys.db.damping);
+    memory_of(sys, &b, dt_s, duration_s)
+}
+
+/// The same from the given damping samples (at the database's frequencies).
+pub fn memory_of(sys: &VesselSystem, b: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> Memory {
+    let db = &sys.db;
+    match (sys.spec.irf.tail, &db.added_mass_inf) {
+        (TailChoice::Fitted, Some(a_inf)) => {
+            let fit = radiation::fit_tail(&db.omega_rad_s, b, &db.added_mass, a_inf, dt_s, duration_s);
+            Memory {
+                irf: fit.irf,
+                tail: fit.tail,
+                fit_residuals: Some((fit.residual_cubic, fit.residual_fitted)),
+            }
+        }
+        _ => {
+            let tail = DampingTail::cubic(&db.omega_rad_s, b);
+            Memory {
+                irf: radiation::impulse_response_of(&db.omega_rad_s, b, &tail, dt_s, duration_s),
+                tail,
+                fit_residuals: None,
+            }
+        }
+    }
+}
+
+/// The active DOFs' passive damping, added mass, A_inf and damping tail (the inputs of the radiation
+/// models).
+pub struct ActiveRadiation {
+    pub damping: Vec<DMatrix<f64>>,
+    pub added_mass: Vec<DMatrix<f64>>,
+    pub a_inf: DMatrix<f64>,
+    pub tail: DampingTail,
+}
+
+pub fn active_radiation(sys: &VesselSystem, a_inf: &DMatrix<f64>, tail: &DampingTail) -> ActiveRadiation {
     let act = sys.active_indices();
     let sub = |m: &DMatrix<f64>| DMatrix::from_fn(act.len(), act.len(), |r, c| m[(act[r], act[c])]);
     let b: Vec<DMatrix<f64>> = sys.db.damping.iter().map(sub).collect();
     let (b, _) = radiation::passive_damping(&b);
-    (b, sys.db.added_mass.iter().map(sub).collect(), sub(a_inf))
+    ActiveRadiation {
+        damping: b,
+        added_mass: sys.db.added_mass.iter().map(sub).collect(),
+        a_inf: sub(a_inf),
+        tail: tail.sub(&act),
+    }
 }
 
 /// The state-space fit of the active DOFs' radiation as the time-domain model makes it (see
 /// [`modal::fit`]), and its (damping, added mass) errors, the added mass against the given A_inf.
-pub fn state_space(sys: &VesselSystem, a_inf: &DMatrix<f64>) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
-    let (b, a, ai) = active_radiation(sys, a_inf);
-    let model = modal::fit(&sys.db.omega_rad_s, &b, &a, &ai, modal::ModalOptions::default())?;
-    let (eb, ea) = modal::fit_errors(&model, &sys.db.omega_rad_s, &b, &a, &ai);
+pub fn state_space(
+    sys: &VesselSystem,
+    a_inf: &DMatrix<f64>,
+    tail: &DampingTail,
+) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
+    let r = active_radiation(sys, a_inf, tail);
+    let model = modal::fit(
+        &sys.db.omega_rad_s,
+        &r.damping,
+        &r.added_mass,
+        &r.a_inf,
+        &r.tail,
+        modal::ModalOptions::default(),
+    )?;
+    let (eb, ea) = modal::fit_errors(&model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf);
     Ok((model, eb, ea))
 }
 
-/// The IRF of a system with its configured (or default) time grid.
-pub fn system_irf(sys: &VesselSystem) -> Irf {
+/// The memory of the database as it is (its damping not made passive, so the checks see the BEM's
+/// data), with the configured (or default) time grid and damping tail.
+pub fn system_memory(sys: &VesselSystem) -> Memory {
     let dur = sys
         .spec
         .irf
         .duration_s
         .unwrap_or_else(|| radiation::default_duration_s(&sys.db));
-    radiation::impulse_response(&sys.db, sys.spec.irf.dt_s, dur)
+    memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, dur)
+}
+
+/// The IRF of [`system_memory`].
+pub fn system_irf(sys: &VesselSystem) -> Irf {
+    system_memory(sys).irf
 }
 
 pub fn check(sys: &VesselSystem) -> CheckReport {
@@ -113,7 +200,11 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
             negative_damping.push((i, ws));
         }
     }
-    let irf = system_irf(sys);
+    let Memory {
+        irf,
+        tail,
+        fit_residuals,
+    } = system_memory(sys);
     let (a_inf, a_inf_source) = choose_a_inf(sys, &irf);
     let kk = radiation::kramers_kronig(db, &irf, &a_inf);
     let kk_ogilvie = match a_inf_source {
@@ -129,8 +220,12 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
         a_inf,
         a_inf_source,
         irf,
+        tail,
+        tail_fit_residuals: fit_residuals,
         kk,
         kk_ogilvie,
+        asymmetry_added_mass: asymmetry(&db.added_mass),
+        asymmetry_damping: asymmetry(&db.damping),
     }
 }
 

@@ -12,7 +12,7 @@
 //!    relocated as the zeros of the weighting function, unstable ones reflected into the left
 //!    half-plane, none narrower than half the local frequency spacing; then the residues by linear least
 //!    squares with K(0) = 0 exactly. The least-squares rows are real parts only: the database's damping,
-//!    B(0) = 0 and B linear below the data, the IRF's w^-3 tail above it (as the convolution sees B), so
+//!    B(0) = 0 and B linear below the data, the IRF's damping tail above it (as the convolution sees B), so
 //!    the fit's added mass follows by causality from that damping; the added mass still enters the
 //!    pole relocation, where the weighting function multiplies the complex data K = B + i w (A - A_inf)
 //!    (with the imaginary part zeroed, the relocation diverged on the one-ship demo).
@@ -33,6 +33,7 @@
 //! xi_{k+1} = E xi_k + g0 beta_k + g1 beta_{k+1}, E = exp(lambda h), g1 = (E - 1 - lambda h)/(lambda^2 h),
 //! g0 = (E - 1)/lambda - g1.
 
+use super::radiation::DampingTail;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
@@ -183,6 +184,7 @@ pub fn fit(
     damping: &[DMatrix<f64>],
     added_mass: &[DMatrix<f64>],
     a_inf: &DMatrix<f64>,
+    tail: &DampingTail,
     opts: ModalOptions,
 ) -> Result<ModalModel, FitError> {
     let nw = omegas.len();
@@ -235,8 +237,8 @@ pub fn fit(
                         let b = 0.5 * (damping[0][(i, j)] + damping[0][(j, i)]);
                         Complex64::new(b * w / omegas[0] / sc(i, j), 0.0)
                     } else {
-                        let b = 0.5 * (damping[nw - 1][(i, j)] + damping[nw - 1][(j, i)]);
-                        Complex64::new(b * (wn / w).powi(super::radiation::TAIL_POWER) / sc(i, j), 0.0)
+                        let b = tail.at(*w);
+                        Complex64::new(0.5 * (b[(i, j)] + b[(j, i)]) / sc(i, j), 0.0)
                     }
                 })
                 .collect()
@@ -1001,7 +1003,8 @@ mod tests {
             tolerance: 0.001,
             reduction_tolerance: 0.001,
         };
-        let m = fit(&ws, &b, &a, &ai, opts).unwrap();
+        let tail = DampingTail::cubic(&ws, &b);
+        let m = fit(&ws, &b, &a, &ai, &tail, opts).unwrap();
         let scale = super::super::radiation::diagonal_peaks(&b);
         let mut worst = 0.0f64;
         for w in &ws {

@@ -7,10 +7,18 @@
 //!
 //! How shipcast evaluates them (documented choices, tested below):
 //! - B(w) between database frequencies is linear; below the lowest it falls linearly to B(0) = 0; above
-//!   the highest, w_N, it decays as B(w_N) (w_N / w)^3 (sampled on nodes spaced by 10 % up to 20 w_N,
-//!   where the tail holds 1/400 of its own integral's remainder and is cut). Every cosine transform of this
-//!   piecewise-linear B is exact (closed form per segment, [`pl_weights`]): no quadrature error,
-//!   whatever t.
+//!   the highest, w_N, it follows the damping tail [`DampingTail`] (sampled on nodes spaced by 10 % up to
+//!   20 w_N, where it is cut): B_ij(w) = B_N,ij r^((p_i + p_j)/2) + D_ij (r^q - r^3) with r = w_N/w and
+//!   q = TAIL_FAR_POWER = 2: the database's last damping B_N decaying as w^-p_i per DOF, plus a far part D that decays more
+//!   slowly. p_i = 3 and D = 0 (the cubic tail) unless fitted: [`fit_tail`] chooses D (where the data
+//!   ask for more damping above w_N) or p_i > 3 (where they ask for less) so that the added mass
+//!   implied by K matches the database's A(w) with the BEM's own A_inf (Kramers-Kronig, least squares
+//!   over the band). D is positive semi-definite and the near part a congruence of B_N, so the tail
+//!   is passive.
+//!   Why: a database that ends where a hull still radiates (the 120 m lighter at 1.6 rad/s) misses damping
+//!   whose Kramers-Kronig image is an added-mass error across the band; its A(w) and A_inf still say how
+//!   much is missing. Every cosine transform of this piecewise-linear B is exact (closed form per segment,
+//!   [`pl_weights`]): no quadrature error, whatever t.
 //! - K(t) is sampled on t = 0, dt, ..., T (dt default 0.05 s; T default pi / (smallest frequency
 //!   spacing), the longest memory the database resolves, clamped to 30..600 s). It is used as zero past T.
 //! - The sine and cosine transforms of K back to A and B treat K as linear between its samples, again
@@ -23,8 +31,15 @@ use super::HydroDb;
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 
-/// Exponent of the high-frequency damping tail B ~ w^-TAIL_POWER.
+/// Exponent of the damping tail's near part, B_N (w_N/w)^TAIL_POWER.
 pub const TAIL_POWER: i32 = 3;
+/// Exponent of the damping tail's far part, D (w_N/w)^TAIL_FAR_POWER: a slower decay than the near
+/// part's, so that a fitted D adds damping above w_N. The in-band fit barely depends on it (it sets
+/// mostly int B / w^2); 2 put the fitted tail of the two-ship demo's lighter closest to a Capytaine run
+/// of the same pair continued to 2.2 rad/s (`tools/bem/make_db.py --preset pair-fine`).
+pub const TAIL_FAR_POWER: f64 = 2.0;
+/// Largest fitted far level D_ii, in units of B_N,ii: the most that keeps the tail at or below B_N.
+pub const TAIL_FAR_CAP: f64 = 3.0;
 /// The tail is sampled up to this multiple of the highest database frequency.
 pub const TAIL_END_FACTOR: f64 = 20.0;
 /// Ratio between successive tail nodes.
@@ -94,19 +109,96 @@ impl Irf {
     }
 }
 
+/// The damping above the database's last frequency (see the module documentation):
+/// B_ij(w) = B_N,ij r^((p_i + p_j)/2) + D_ij (r^q - r^3), r = w_N/w <= 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DampingTail {
+    /// w_N, the database's last frequency, rad/s.
+    pub omega_n_rad_s: f64,
+    /// B(w_N), the database's last damping (as the models use it: made passive).
+    pub b_n: DMatrix<f64>,
+    /// p_i, each DOF's decay exponent of the near part: TAIL_POWER unless fitted (never less).
+    pub near_power: Vec<f64>,
+    /// D, the far level: zero for the cubic tail, positive semi-definite when fitted.
+    pub far: DMatrix<f64>,
+}
+
+impl DampingTail {
+    /// The cubic tail B_N (w_N/w)^3 from the last of `damping` sampled at `omegas`.
+    pub fn cubic(omegas: &[f64], damping: &[DMatrix<f64>]) -> DampingTail {
+        let n = damping.first().map(|b| b.nrows()).unwrap_or(0);
+        DampingTail {
+            omega_n_rad_s: omegas.last().copied().unwrap_or(1.0),
+            b_n: damping.last().cloned().unwrap_or_else(|| DMatrix::zeros(n, n)),
+            near_power: vec![TAIL_POWER as f64; n],
+            far: DMatrix::zeros(n, n),
+        }
+    }
+
+    /// The far part's shape at w >= w_N: (w_N/w)^q - (w_N/w)^3.
+    fn far_shape(&self, omega_rad_s: f64) -> f64 {
+        let r = self.omega_n_rad_s / omega_rad_s;
+        r.powf(TAIL_FAR_POWER) - r.powi(TAIL_POWER)
+    }
+
+    /// B(w) for w >= w_N. The near part is S B_N S with S = diag(r^(p_i/2)), the far part D times a
+    /// positive shape: both positive semi-definite when B_N and D are.
+    pub fn at(&self, omega_rad_s: f64) -> DMatrix<f64> {
+        let r = self.omega_n_rad_s / omega_rad_s;
+        let s: Vec<f64> = self.near_power.iter().map(|p| r.powf(0.5 * p)).collect();
+        let far = self.far_shape(omega_rad_s);
+        DMatrix::from_fn(self.b_n.nrows(), self.b_n.ncols(), |i, j| {
+            self.b_n[(i, j)] * s[i] * s[j] + self.far[(i, j)] * far
+        })
+    }
+
+    /// The nodes beyond w_N on which the IRF samples the tail.
+    pub fn nodes(&self) -> Vec<f64> {
+        let mut out = vec![];
+        let mut x = self.omega_n_rad_s * TAIL_NODE_RATIO;
+        while x <= TAIL_END_FACTOR * self.omega_n_rad_s {
+            out.push(x);
+            x *= TAIL_NODE_RATIO;
+        }
+        out
+    }
+
+    /// The tail of the DOFs `idx` only.
+    pub fn sub(&self, idx: &[usize]) -> DampingTail {
+        let n = idx.len();
+        let pick = |m: &DMatrix<f64>| DMatrix::from_fn(n, n, |r, c| m[(idx[r], idx[c])]);
+        DampingTail {
+            omega_n_rad_s: self.omega_n_rad_s,
+            b_n: pick(&self.b_n),
+            near_power: idx.iter().map(|&i| self.near_power[i]).collect(),
+            far: pick(&self.far),
+        }
+    }
+
+    /// max_i D_ii / B_N,ii over the DOFs with damping at w_N: how far the fit added damping.
+    pub fn far_ratio(&self) -> f64 {
+        (0..self.b_n.nrows())
+            .filter(|&i| self.b_n[(i, i)] > 0.0)
+            .map(|i| self.far[(i, i)] / self.b_n[(i, i)])
+            .fold(0.0, f64::max)
+    }
+
+    /// The largest fitted near exponent: how far the fit took damping away.
+    pub fn max_near_power(&self) -> f64 {
+        self.near_power.iter().copied().fold(TAIL_POWER as f64, f64::max)
+    }
+}
+
 /// The frequency nodes and damping values the IRF integrates: 0, the data, and the tail.
-fn damping_nodes(omegas: &[f64], damping: &[DMatrix<f64>], n: usize) -> (Vec<f64>, Vec<DMatrix<f64>>) {
+fn damping_nodes(omegas: &[f64], damping: &[DMatrix<f64>], tail: &DampingTail) -> (Vec<f64>, Vec<DMatrix<f64>>) {
+    let n = tail.b_n.nrows();
     let mut w = vec![0.0];
     let mut b = vec![DMatrix::zeros(n, n)];
     w.extend_from_slice(omegas);
     b.extend(damping.iter().cloned());
-    let wn = *omegas.last().unwrap_or(&1.0);
-    let bn = damping.last().cloned().unwrap_or_else(|| DMatrix::zeros(n, n));
-    let mut x = wn * TAIL_NODE_RATIO;
-    while x <= TAIL_END_FACTOR * wn {
+    for x in tail.nodes() {
         w.push(x);
-        b.push(&bn * (wn / x).powi(TAIL_POWER));
-        x *= TAIL_NODE_RATIO;
+        b.push(tail.at(x));
     }
     (w, b)
 }
@@ -179,29 +271,184 @@ fn unstack(m: &DMatrix<f64>, n: usize) -> Vec<DMatrix<f64>> {
         .collect()
 }
 
-/// K(t) on t = 0, dt, ..., duration, from the database's damping as it is.
+/// K(t) on t = 0, dt, ..., duration, from the database's damping as it is and the cubic tail.
 pub fn impulse_response(db: &HydroDb, dt_s: f64, duration_s: f64) -> Irf {
-    impulse_response_of(&db.omega_rad_s, &db.damping, dt_s, duration_s)
+    let tail = DampingTail::cubic(&db.omega_rad_s, &db.damping);
+    impulse_response_of(&db.omega_rad_s, &db.damping, &tail, dt_s, duration_s)
 }
 
-/// K(t) on t = 0, dt, ..., duration from damping samples `damping[k]` at `omegas[k]` (ascending).
-pub fn impulse_response_of(omegas: &[f64], damping: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> Irf {
-    let n = damping.first().map(|b| b.nrows()).unwrap_or(0);
-    let (w, b) = damping_nodes(omegas, damping, n);
+/// K(t) on t = 0, dt, ..., duration from damping samples `damping[k]` at `omegas[k]` (ascending) and the
+/// tail beyond them.
+pub fn impulse_response_of(
+    omegas: &[f64],
+    damping: &[DMatrix<f64>],
+    tail: &DampingTail,
+    dt_s: f64,
+    duration_s: f64,
+) -> Irf {
+    let (w, b) = damping_nodes(omegas, damping, tail);
+    irf_of_nodes(&w, &b, tail.b_n.nrows(), dt_s, duration_s)
+}
+
+/// K(t) = (2/pi) int B cos(w t) dw for B linear between the nodes `w` (zero outside them).
+fn irf_of_nodes(w: &[f64], b: &[DMatrix<f64>], n: usize, dt_s: f64, duration_s: f64) -> Irf {
     let nt = (duration_s / dt_s).round() as usize + 1;
     let mut weights = DMatrix::zeros(nt, w.len());
     let mut row = vec![0.0; w.len()];
     for m in 0..nt {
-        pl_weights(&w, m as f64 * dt_s, false, &mut row);
+        pl_weights(w, m as f64 * dt_s, false, &mut row);
         for (k, v) in row.iter().enumerate() {
             weights[(m, k)] = v * 2.0 / PI;
         }
     }
-    let kt = weights * stack(&b, n);
+    let kt = weights * stack(b, n);
     Irf {
         dt_s,
         k: unstack(&kt, n),
     }
+}
+
+/// The outcome of [`fit_tail`].
+#[derive(Debug, Clone)]
+pub struct TailFit {
+    pub tail: DampingTail,
+    /// K(t) with the fitted tail.
+    pub irf: Irf,
+    /// Worst |A_K(w) - A(w)| / sqrt(sA_i sA_j) over the band and every pair with the target A_inf:
+    /// with the cubic tail, and with the fitted one.
+    pub residual_cubic: f64,
+    pub residual_fitted: f64,
+}
+
+/// Near exponents the fit tries for a DOF whose data ask for less damping than the cubic tail.
+const NEAR_POWERS: [f64; 9] = [3.0, 3.5, 4.0, 5.0, 6.0, 8.0, 10.0, 13.0, 16.0];
+
+/// Fits the damping tail so that the added mass implied by K, A_inf - (1/w) int K sin, matches the
+/// database's `added_mass` in the band w <= KK_BAND_FRACTION w_N given the BEM's `a_inf`:
+/// 1. with the cubic tail, the residual r_ij(w) = (Ogilvie estimate - A_inf)_ij (symmetric parts);
+/// 2. the far level D by linear least squares per DOF pair (K is linear in D: r ~ D g(w), g the added
+///    mass image of the far shape); DOFs whose own D_ii comes out negative get none, and D is projected
+///    onto the PSD matrices (scaled by sqrt(max_w B_ii)) and capped at TAIL_FAR_CAP B_N,ii;
+/// 3. for those DOFs (their data ask for less damping above w_N), the near exponent p_i from
+///    NEAR_POWERS that best fits their diagonal residual.
+///
+/// `damping` should be passive ([`passive_damping`]). K is sampled as the models sample it (`dt_s`,
+/// `duration_s`), so the fit removes the residual they see.
+pub fn fit_tail(
+    omegas: &[f64],
+    damping: &[DMatrix<f64>],
+    added_mass: &[DMatrix<f64>],
+    a_inf: &DMatrix<f64>,
+    dt_s: f64,
+    duration_s: f64,
+) -> TailFit {
+    let cubic = DampingTail::cubic(omegas, damping);
+    let irf0 = impulse_response_of(omegas, damping, &cubic, dt_s, duration_s);
+    let n = cubic.b_n.nrows();
+    let wn = cubic.omega_n_rad_s;
+    let band: Vec<usize> = (0..omegas.len())
+        .filter(|&k| omegas[k] <= KK_BAND_FRACTION * wn)
+        .collect();
+    let band_w: Vec<f64> = band.iter().map(|&k| omegas[k]).collect();
+    let scale_a = diagonal_peaks(added_mass);
+    let sym = |m: &DMatrix<f64>| (m + m.transpose()) * 0.5;
+    let a_inf_sym = sym(a_inf);
+    // residual per band frequency, symmetric, and its worst scaled entry
+    let residual = |irf: &Irf| -> Vec<DMatrix<f64>> {
+        let est = ogilvie_estimates_of(omegas, added_mass, irf);
+        band.iter().map(|&k| sym(&est[k]) - &a_inf_sym).collect()
+    };
+    let worst = |r: &[DMatrix<f64>]| {
+        r.iter()
+            .flat_map(|m| (0..n).flat_map(move |i| (0..n).map(move |j| (i, j, m[(i, j)]))))
+            .map(|(i, j, v)| v.abs() / (scale_a[i] * scale_a[j]).sqrt())
+            .fold(0.0, f64::max)
+    };
+    let r0 = residual(&irf0);
+    let residual_cubic = worst(&r0);
+    // the added-mass image g(w) = -(1/w) int k sin of a unit damping `shape` beyond w_N
+    let nodes: Vec<f64> = std::iter::once(wn).chain(cubic.nodes()).collect();
+    let image = |shape: &dyn Fn(f64) -> f64| -> Vec<f64> {
+        let h: Vec<DMatrix<f64>> = nodes.iter().map(|&x| DMatrix::from_element(1, 1, shape(x))).collect();
+        let k = irf_of_nodes(&nodes, &h, 1, dt_s, duration_s);
+        transform_irf(&k, &band_w, true)
+            .iter()
+            .zip(&band_w)
+            .map(|(s, w)| -s[(0, 0)] / w)
+            .collect()
+    };
+    let lsq = |g: &[f64], i: usize, j: usize| {
+        let gg: f64 = g.iter().map(|x| x * x).sum();
+        let rg: f64 = r0.iter().zip(g).map(|(r, gk)| r[(i, j)] * gk).sum();
+        if gg > 0.0 { rg / gg } else { 0.0 }
+    };
+    let g_far = image(&|x| cubic.far_shape(x));
+    let far_raw = DMatrix::from_fn(n, n, |i, j| lsq(&g_far, i, j));
+    let wants: Vec<bool> = (0..n).map(|i| far_raw[(i, i)] > 0.0).collect();
+    // DOFs that ask for less damping get no far part, their couplings included (the projection would
+    // otherwise hand them damping from their couplings)
+    let far_raw = DMatrix::from_fn(n, n, |i, j| if wants[i] && wants[j] { far_raw[(i, j)] } else { 0.0 });
+    let far = if far_raw.iter().all(|v| v.is_finite()) {
+        psd_part(&far_raw, &diagonal_peaks(damping))
+    } else {
+        DMatrix::zeros(n, n)
+    };
+    // the far part never lifts the tail above the data's last damping: B_N r^3 + D r^2 (1 - r) <= B_N
+    // for r = w_N/w in (0, 1] needs D_ii <= TAIL_FAR_CAP B_N,ii; enforced by the congruence S D S (S
+    // diagonal, so D stays PSD). Without it a database whose A_inf is off by a constant (WEC-Sim's RM3)
+    // had the fit invent a damping bump 10^7 times its last value
+    let cap: Vec<f64> = (0..n)
+        .map(|i| {
+            let (d, b) = (far[(i, i)], TAIL_FAR_CAP * cubic.b_n[(i, i)].max(0.0));
+            if d > b { (b / d).sqrt() } else { 1.0 }
+        })
+        .collect();
+    let far = DMatrix::from_fn(n, n, |i, j| cap[i] * far[(i, j)] * cap[j]);
+    // near exponents for the DOFs that ask for less damping: B_N,ii (r^p - r^3) has image g_p
+    let images: Vec<Vec<f64>> = NEAR_POWERS
+        .iter()
+        .map(|&p| image(&|x: f64| (wn / x).powf(p) - (wn / x).powi(TAIL_POWER)))
+        .collect();
+    let near_power: Vec<f64> = (0..n)
+        .map(|i| {
+            let b = cubic.b_n[(i, i)];
+            if wants[i] || b <= 0.0 {
+                return TAIL_POWER as f64;
+            }
+            let misfit = |g: &[f64]| -> f64 { r0.iter().zip(g).map(|(r, gk)| (r[(i, i)] - b * gk).powi(2)).sum() };
+            NEAR_POWERS
+                .iter()
+                .zip(&images)
+                .map(|(p, g)| (*p, misfit(g)))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .map(|(p, _)| p)
+                .unwrap_or(TAIL_POWER as f64)
+        })
+        .collect();
+    let tail = DampingTail {
+        near_power,
+        far,
+        ..cubic
+    };
+    let irf = impulse_response_of(omegas, damping, &tail, dt_s, duration_s);
+    let residual_fitted = worst(&residual(&irf));
+    TailFit {
+        tail,
+        irf,
+        residual_cubic,
+        residual_fitted,
+    }
+}
+
+/// The positive semi-definite part of the symmetric `m`, in coordinates scaled by sqrt(`peaks`).
+fn psd_part(m: &DMatrix<f64>, peaks: &[f64]) -> DMatrix<f64> {
+    let n = m.nrows();
+    let s: Vec<f64> = peaks.iter().map(|p| p.sqrt()).collect();
+    let scaled = DMatrix::from_fn(n, n, |i, j| 0.5 * (m[(i, j)] + m[(j, i)]) / (s[i] * s[j]));
+    let eig = scaled.symmetric_eigen();
+    let clipped = eig.eigenvalues.map(|l| l.max(0.0));
+    let p = &eig.eigenvectors * DMatrix::from_diagonal(&clipped) * eig.eigenvectors.transpose();
+    DMatrix::from_fn(n, n, |i, j| 0.5 * (p[(i, j)] + p[(j, i)]) * s[i] * s[j])
 }
 
 /// int_0^T K(t) trig(w t) dt at each w, K linear between samples; one n x n matrix per w.
@@ -221,10 +468,15 @@ pub fn transform_irf(irf: &Irf, omegas: &[f64], sine: bool) -> Vec<DMatrix<f64>>
 
 /// Ogilvie's A_inf estimate at each database frequency: A(w) + (1/w) int K sin.
 pub fn ogilvie_estimates(db: &HydroDb, irf: &Irf) -> Vec<DMatrix<f64>> {
-    let sines = transform_irf(irf, &db.omega_rad_s, true);
-    db.added_mass
+    ogilvie_estimates_of(&db.omega_rad_s, &db.added_mass, irf)
+}
+
+/// Ogilvie's A_inf estimate at each of `omegas` from the added mass there.
+pub fn ogilvie_estimates_of(omegas: &[f64], added_mass: &[DMatrix<f64>], irf: &Irf) -> Vec<DMatrix<f64>> {
+    let sines = transform_irf(irf, omegas, true);
+    added_mass
         .iter()
-        .zip(&db.omega_rad_s)
+        .zip(omegas)
         .zip(sines)
         .map(|((a, w), s)| a + s / *w)
         .collect()
@@ -419,5 +671,85 @@ mod tests {
         ainf[(2, 2)] = 1.1 * a_inf;
         let e = kramers_kronig(&db, &irf, &ainf);
         assert!(e[0].added_mass > 0.05, "{e:?}");
+    }
+
+    /// Two coupled DOFs whose damping goes on past the database's last frequency w_N = 1: DOF 0 decays
+    /// as w^-2 (slower than the cubic tail: damping is missing), DOF 1 as exp(-w^2/0.3) (faster: the
+    /// cubic tail adds too much). A(w) is made from the whole B by the relations themselves.
+    /// (frequencies, damping, added mass, A_inf) of a test database.
+    type TestDb = (Vec<f64>, Vec<DMatrix<f64>>, Vec<DMatrix<f64>>, DMatrix<f64>);
+
+    fn truncated_pair() -> TestDb {
+        let b = |w: f64| {
+            let b0 = 1000.0 * w * w / (1.0 + w * w).powi(2);
+            let b1 = 1000.0 * w * w * (-w * w / 0.3).exp();
+            let c = 0.3 * (b0 * b1).sqrt();
+            DMatrix::from_row_slice(2, 2, &[b0, c, c, b1])
+        };
+        let full_w: Vec<f64> = (1..=4000).map(|k| k as f64 * 0.01).collect();
+        let full_b: Vec<DMatrix<f64>> = full_w.iter().map(|w| b(*w)).collect();
+        // the full B decays to ~0.6 % of its peak by 40 rad/s (DOF 0): its own cubic tail is negligible
+        let tail = DampingTail::cubic(&full_w, &full_b);
+        let irf = impulse_response_of(&full_w, &full_b, &tail, 0.05, 60.0);
+        let a_inf = DMatrix::from_row_slice(2, 2, &[5000.0, 100.0, 100.0, 3000.0]);
+        let ws: Vec<f64> = (1..=100).map(|k| k as f64 * 0.01).collect();
+        let sines = transform_irf(&irf, &ws, true);
+        let a: Vec<DMatrix<f64>> = sines.iter().zip(&ws).map(|(s, w)| &a_inf - s / *w).collect();
+        (ws.clone(), ws.iter().map(|w| b(*w)).collect(), a, a_inf)
+    }
+
+    #[test]
+    fn the_fitted_tail_restores_the_missing_damping() {
+        let (ws, b, a, a_inf) = truncated_pair();
+        let fit = fit_tail(&ws, &b, &a, &a_inf, 0.05, 60.0);
+        // the cubic tail leaves an added-mass residual; the fit removes most of it
+        assert!(fit.residual_cubic > 0.01, "{}", fit.residual_cubic);
+        assert!(
+            fit.residual_fitted < 0.25 * fit.residual_cubic,
+            "{} vs {}",
+            fit.residual_fitted,
+            fit.residual_cubic
+        );
+        let t = &fit.tail;
+        // more damping where it decays slowly, less where it decays fast
+        assert!(t.far[(0, 0)] > 0.0 && t.near_power[0] == TAIL_POWER as f64, "{t:?}");
+        assert!(t.near_power[1] > TAIL_POWER as f64 && t.far[(1, 1)] == 0.0, "{t:?}");
+        // and what it adds is near what is missing: the true B at 2 w_N against the tail there
+        let b0 = |w: f64| 1000.0 * w * w / (1.0 + w * w).powi(2);
+        let (cubic_at_2, fitted_at_2) = (b0(1.0) / 8.0, t.at(2.0)[(0, 0)]);
+        assert!(
+            (fitted_at_2 - b0(2.0)).abs() < 0.5 * (cubic_at_2 - b0(2.0)).abs(),
+            "true {} cubic {cubic_at_2} fitted {fitted_at_2}",
+            b0(2.0)
+        );
+    }
+
+    #[test]
+    fn the_fitted_tail_is_passive_and_continuous() {
+        let (ws, b, a, a_inf) = truncated_pair();
+        let t = fit_tail(&ws, &b, &a, &a_inf, 0.05, 60.0).tail;
+        // B(w_N) itself at the join
+        assert!((t.at(1.0) - b.last().unwrap()).amax() < 1e-9 * b.last().unwrap().amax());
+        for k in 0..400 {
+            let w = 1.0 + 0.05 * k as f64;
+            let m = t.at(w);
+            let lowest = m.clone().symmetric_eigen().eigenvalues.min();
+            assert!(lowest >= -1e-12 * m.amax(), "w {w}: {m}");
+        }
+    }
+
+    #[test]
+    fn a_database_without_missing_damping_keeps_the_cubic_tail_close() {
+        // B decays fast (exp) and is negligible at w_N: there is nothing to fit, the tail stays tiny
+        let db = resonant_db();
+        let ws = db.omega_rad_s.clone();
+        let irf = impulse_response(&db, 0.05, 60.0);
+        let sines = transform_irf(&irf, &ws, true);
+        let mut ainf = DMatrix::zeros(6, 6);
+        ainf[(2, 2)] = 5000.0;
+        let a: Vec<DMatrix<f64>> = sines.iter().zip(&ws).map(|(s, w)| &ainf - s / *w).collect();
+        let fit = fit_tail(&ws, &db.damping, &a, &ainf, 0.05, 60.0);
+        assert!(fit.residual_fitted <= fit.residual_cubic + 1e-12);
+        assert!(fit.tail.far.amax() <= 1e-6 * 1000.0, "{:?}", fit.tail.far);
     }
 }

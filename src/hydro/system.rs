@@ -16,6 +16,18 @@ use super::{Dof, Error, Result};
 use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3};
 use serde::Deserialize;
 
+/// The damping tail beyond the database's last frequency ([`super::radiation::DampingTail`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TailChoice {
+    /// Fitted so the added mass implied by K matches the database's A(w) with its A_inf (the default; the
+    /// cubic tail when the database has no PER = 0 rows).
+    #[default]
+    Fitted,
+    /// B_N (w_N/w)^3.
+    Cubic,
+}
+
 /// How A_inf is obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -69,6 +81,7 @@ struct SystemFile {
 struct IrfFile {
     dt_s: Option<f64>,
     duration_s: Option<f64>,
+    tail: Option<TailChoice>,
 }
 
 fn one() -> f64 {
@@ -110,6 +123,8 @@ pub struct IrfOptions {
     pub dt_s: f64,
     /// Memory length, s. Default: pi / (smallest frequency spacing), clamped to 30..600 s.
     pub duration_s: Option<f64>,
+    /// The damping tail beyond the database's last frequency.
+    pub tail: TailChoice,
 }
 
 impl Default for IrfOptions {
@@ -117,6 +132,7 @@ impl Default for IrfOptions {
         IrfOptions {
             dt_s: 0.05,
             duration_s: None,
+            tail: TailChoice::Fitted,
         }
     }
 }
@@ -217,6 +233,9 @@ impl SystemSpec {
                     return Err(key("irf.duration_s", format!("must be in [1, 3600] s, found {d}")));
                 }
                 irf.duration_s = Some(d);
+            }
+            if let Some(t) = f.tail {
+                irf.tail = t;
             }
         }
         if raw.body.is_empty() {

@@ -2,7 +2,7 @@
 
 use super::modal::ModalStep;
 use super::{Error, Result};
-use crate::hydro::check::active_radiation;
+use crate::hydro::check::{Memory, active_radiation, memory};
 use crate::hydro::modal::{self, ModalModel, ModalOptions};
 use crate::hydro::radiation::{self, default_duration_s};
 use crate::hydro::system::AInfSource;
@@ -139,13 +139,12 @@ impl TimeModel {
         let sub = |m: &DMatrix<f64>| DMatrix::from_fn(n, n, |r, c| m[(active[r], active[c])]);
         let dt = opts.dt_s;
         let u = opts.speed_m_s;
-        // the IRF at the solver's step, from passive damping
-        let (b_pass_all, _) = radiation::passive_damping(&sys.db.damping);
+        // the IRF at the solver's step, from passive damping and the damping tail (fitted at this step)
         let memory_s = opts
             .memory_s
             .or(sys.spec.irf.duration_s)
             .unwrap_or_else(|| default_duration_s(&sys.db));
-        let irf_all = radiation::impulse_response_of(&sys.db.omega_rad_s, &b_pass_all, dt, memory_s);
+        let Memory { irf: irf_all, tail, .. } = memory(sys, dt, memory_s);
         // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
         // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
         // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
@@ -189,12 +188,13 @@ impl TimeModel {
                 (Kernel::Convolution { taps, k }, d)
             }
             RadiationMethod::StateSpace => {
-                let (b, a_act, a_inf_act) = active_radiation(sys, &a_inf_all);
+                let r = active_radiation(sys, &a_inf_all, &tail);
                 let model = modal::fit(
                     &sys.db.omega_rad_s,
-                    &b,
-                    &a_act,
-                    &a_inf_act,
+                    &r.damping,
+                    &r.added_mass,
+                    &r.a_inf,
+                    &r.tail,
                     ModalOptions {
                         tolerance: opts.ss_tolerance,
                         ..ModalOptions::default()
