@@ -793,12 +793,13 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 ..RomOptions::default()
             };
             let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
+            let kernels: Vec<_> = omegas.iter().map(|w| model.kernel_at(*w)).collect();
             for &h in &headings_deg {
                 let mut rows = vec![];
-                for &w in &omegas {
+                for (&w, k) in omegas.iter().zip(&kernels) {
                     rows.push(
                         model
-                            .implied_rao(w, h.to_radians())
+                            .implied_rao_with(k, w, h.to_radians())
                             .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?,
                     );
                 }

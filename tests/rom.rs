@@ -26,7 +26,20 @@ fn load(rel: &str) -> VesselSystem {
 
 /// Worst |TD - FD| over each (mode, heading) curve, relative to that curve's FD peak.
 fn td_against(system: &str, radiation: &str, reference: &str, dt: &str, heading: Option<&str>) -> (f64, String) {
-    let mut td_args = vec!["rao", system, "--method", "time", "--radiation", radiation, "--dt", dt];
+    rao_against(system, "time", radiation, reference, dt, heading)
+}
+
+/// Worst |RAO by `method` - RAO by `reference`| over each (mode, heading) curve, relative to that curve's
+/// peak by `reference`.
+fn rao_against(
+    system: &str,
+    method: &str,
+    radiation: &str,
+    reference: &str,
+    dt: &str,
+    heading: Option<&str>,
+) -> (f64, String) {
+    let mut td_args = vec!["rao", system, "--method", method, "--radiation", radiation, "--dt", dt];
     let mut ref_args = vec![
         "rao",
         system,
@@ -78,7 +91,7 @@ fn td_against(system: &str, radiation: &str, reference: &str, dt: &str, heading:
         }
     }
     eprintln!(
-        "{system} ({radiation}, dt {dt}) against {reference}: worst {:.3} % of the curve peak at {}",
+        "{system} ({method}, {radiation}, dt {dt}) against {reference}: worst {:.3} % of the curve peak at {}",
         100.0 * worst.0,
         worst.1
     );
@@ -141,9 +154,9 @@ fn one_ship_time_domain_matches_its_floor_state_space() {
 /// A run of the forecaster from (x0, v0) with no past motion.
 /// Two ships (the pair demo, every DOF, full coupling), heading 150 deg, state space, dt 0.025 s: the
 /// time domain against its own floor. Measured 0.24 % (lighter sway at its 1.23 rad/s coupled
-/// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain the floor
-/// itself is 1.8 % off (lighter yaw at 0.65 rad/s; the convolution's floor 1.6 %, lighter yaw at 0.05
-/// rad/s): the pair database's Kramers-Kronig residual, not asserted here.
+/// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain: 1.09 %
+/// at the same resonance (before the database was symmetrized and the damping tail fitted: 1.8 %,
+/// lighter yaw at 0.65 rad/s), not asserted: see the convolution's test below.
 #[test]
 fn two_ship_time_domain_matches_its_floor_state_space() {
     let (e, at) = td_against(
@@ -154,6 +167,27 @@ fn two_ship_time_domain_matches_its_floor_state_space() {
         Some("150"),
     );
     assert!(e <= TD_FLOOR_TOL, "{e} at {at}");
+}
+
+/// The floor a time-domain model of the pair converges to (the convolution's, `--method implied`)
+/// against the database's frequency domain, every mode and heading. Measured 1.14 % (lighter sway at
+/// its 1.23 rad/s heave resonance in head seas, where a 0.02 %-of-scale added-mass difference moves the
+/// response 0.5 %; 0.61 % at heading 150); 6.7 % (lighter yaw in beam seas) before the database was
+/// symmetrized and the damping tail fitted to its added mass. The 1 % is not met at that
+/// resonance: this guards what is.
+const PAIR_FLOOR_TOL: f64 = 0.0125;
+
+#[test]
+fn two_ship_floor_matches_frequency_domain_convolution() {
+    let (e, at) = rao_against(
+        "config/vessels/pair/system.toml",
+        "implied",
+        "convolution",
+        "frequency",
+        "0.05",
+        None,
+    );
+    assert!(e <= PAIR_FLOOR_TOL, "{e} at {at}");
 }
 
 fn run_from_rest_history(

@@ -317,12 +317,22 @@ impl TimeModel {
     /// radiation memory, its A_inf, B_lin, C): the floor a time-domain run converges to as dt -> 0.
     /// Every mode, inactive ones zero, per metre of wave amplitude, zero speed.
     pub fn implied_rao(&self, omega_rad_s: f64, heading_rad: f64) -> Result<Vec<num_complex::Complex64>> {
+        self.implied_rao_with(&self.kernel_at(omega_rad_s), omega_rad_s, heading_rad)
+    }
+
+    /// [`TimeModel::implied_rao`] with the kernel at `omega_rad_s` already computed (`kernel_at`): one
+    /// kernel serves every heading.
+    pub fn implied_rao_with(
+        &self,
+        k: &DMatrix<num_complex::Complex64>,
+        omega_rad_s: f64,
+        heading_rad: f64,
+    ) -> Result<Vec<num_complex::Complex64>> {
         use num_complex::Complex64;
         let n = self.n();
         let mut x = vec![Complex64::default(); self.n_modes];
         let nm = self.db.n_modes;
         self.db.excitation_into(omega_rad_s, heading_rad, &mut x[..nm])?;
-        let k = self.kernel_at(omega_rad_s);
         let w = omega_rad_s;
         let z = DMatrix::from_fn(n, n, |i, j| {
             Complex64::new(
