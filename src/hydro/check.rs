@@ -111,6 +111,13 @@ pub struct ActiveRadiation {
     pub tail: DampingTail,
 }
 
+impl ActiveRadiation {
+    /// The state-space fit of this radiation ([`modal::fit`]) at the database's frequencies `omegas`.
+    pub fn fit(&self, omegas: &[f64], opts: modal::ModalOptions) -> Result<modal::ModalModel, modal::FitError> {
+        modal::fit(omegas, &self.damping, &self.added_mass, &self.a_inf, &self.tail, opts)
+    }
+}
+
 pub fn active_radiation(sys: &VesselSystem, a_inf: &DMatrix<f64>, tail: &DampingTail) -> ActiveRadiation {
     let act = sys.active_indices();
     let sub = |m: &DMatrix<f64>| DMatrix::from_fn(act.len(), act.len(), |r, c| m[(act[r], act[c])]);
@@ -132,14 +139,7 @@ pub fn state_space(
     tail: &DampingTail,
 ) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
     let r = active_radiation(sys, a_inf, tail);
-    let model = modal::fit(
-        &sys.db.omega_rad_s,
-        &r.damping,
-        &r.added_mass,
-        &r.a_inf,
-        &r.tail,
-        modal::ModalOptions::default(),
-    )?;
+    let model = r.fit(&sys.db.omega_rad_s, modal::ModalOptions::default())?;
     let (eb, ea) = modal::fit_errors(&model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf);
     Ok((model, eb, ea))
 }

@@ -3,7 +3,7 @@
 use super::modal::ModalStep;
 use super::{Error, Result};
 use crate::hydro::check::{Memory, active_radiation, memory};
-use crate::hydro::modal::{self, ModalModel, ModalOptions};
+use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation::{self, default_duration_s};
 use crate::hydro::system::AInfSource;
 use crate::hydro::{HydroDb, VesselSystem};
@@ -188,19 +188,15 @@ impl TimeModel {
                 (Kernel::Convolution { taps, k }, d)
             }
             RadiationMethod::StateSpace => {
-                let r = active_radiation(sys, &a_inf_all, &tail);
-                let model = modal::fit(
-                    &sys.db.omega_rad_s,
-                    &r.damping,
-                    &r.added_mass,
-                    &r.a_inf,
-                    &r.tail,
-                    ModalOptions {
-                        tolerance: opts.ss_tolerance,
-                        ..ModalOptions::default()
-                    },
-                )
-                .map_err(|e| Error::Input(format!("state-space radiation: {}", e.0)))?;
+                let model = active_radiation(sys, &a_inf_all, &tail)
+                    .fit(
+                        &sys.db.omega_rad_s,
+                        ModalOptions {
+                            tolerance: opts.ss_tolerance,
+                            ..ModalOptions::default()
+                        },
+                    )
+                    .map_err(|e| Error::Input(format!("state-space radiation: {}", e.0)))?;
                 let step = ModalStep::new(&model, dt);
                 let di = step.instantaneous();
                 let mut d = DMatrix::zeros(n, n);
