@@ -508,7 +508,7 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     let asym = report.asymmetry_added_mass.max(report.asymmetry_damping);
     if asym > 0.01 {
         warnings.push(format!(
-            "A(w) or B(w) unsymmetric by up to {:.2} % of sqrt(X_ii X_jj): the two BEM estimates of a coupling disagree (panels too coarse?); the time-domain models can only follow the symmetric part (tools/bem/make_db.py writes it)",
+            "A(w) or B(w) unsymmetric by up to {:.2} % of sqrt(X_ii X_jj): the two BEM estimates of a coupling disagree (panels too coarse?); a passive time-domain model follows only the symmetric part (tools/bem/make_db.py writes it)",
             100.0 * asym
         ));
     }

@@ -32,13 +32,17 @@ pub struct CheckReport {
     pub asymmetry_damping: f64,
 }
 
-/// max over w and i, j of |X_ij - X_ji| / sqrt(max_w |X_ii| max_w |X_jj|).
+/// max over w and i, j of |X_ij - X_ji| / sqrt(max_w |X_ii| max_w |X_jj|), over the DOFs whose peak is
+/// above 1e-9 of the largest (a DOF that does not radiate, like a spar's yaw, has a numerical-noise peak
+/// that would divide by nothing).
 pub fn asymmetry(ms: &[DMatrix<f64>]) -> f64 {
     let peaks = radiation::diagonal_peaks(ms);
+    let top = peaks.iter().copied().fold(0.0, f64::max);
+    let live = |i: usize| peaks[i] > 1e-9 * top;
     let mut worst = 0.0f64;
     for m in ms {
-        for i in 0..m.nrows() {
-            for j in 0..i {
+        for i in (0..m.nrows()).filter(|&i| live(i)) {
+            for j in (0..i).filter(|&j| live(j)) {
                 worst = worst.max((m[(i, j)] - m[(j, i)]).abs() / (peaks[i] * peaks[j]).sqrt());
             }
         }
@@ -238,4 +242,19 @@ pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
     }
     let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
     format!("{body}.{}", Dof::of_index(i).name())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn asymmetry_is_scaled_and_ignores_silent_dofs() {
+        // DOF 0 and 1 radiate, DOF 2 is numerical noise: its coupling must not count
+        let m = DMatrix::from_row_slice(3, 3, &[4.0, 0.3, 1e-9, 0.1, 1.0, 0.0, 0.0, 0.0, 1e-12]);
+        let a = asymmetry(std::slice::from_ref(&m));
+        // |0.3 - 0.1| / sqrt(4 * 1)
+        assert!((a - 0.1).abs() < 1e-12, "{a}");
+        assert_eq!(asymmetry(&[(&m + m.transpose()) * 0.5]), 0.0);
+    }
 }
