@@ -71,25 +71,25 @@ pub fn choose_a_inf(sys: &VesselSystem, irf: &Irf) -> (DMatrix<f64>, AInfSource)
 /// database's damping made passive and the damping tail the system file asks for (fitted to the BEM's
 /// A_inf unless `irf.tail = "cubic"` or the database has none).
 #[derive(Debug, Clone)]
-pub struct Memory {
+pub struct RadiationMemory {
     pub irf: Irf,
     pub tail: DampingTail,
     /// The fit's worst added-mass residual in band (cubic tail, fitted tail), when fitted.
     pub fit_residuals: Option<(f64, f64)>,
 }
 
-pub fn memory(sys: &VesselSystem, dt_s: f64, duration_s: f64) -> Memory {
+pub fn radiation_memory(sys: &VesselSystem, dt_s: f64, duration_s: f64) -> RadiationMemory {
     let (b, _) = radiation::passive_damping(&sys.db.damping);
-    memory_of(sys, &b, dt_s, duration_s)
+    radiation_memory_of(sys, &b, dt_s, duration_s)
 }
 
 /// The same from the given damping samples (at the database's frequencies).
-pub fn memory_of(sys: &VesselSystem, b: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> Memory {
+pub fn radiation_memory_of(sys: &VesselSystem, b: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> RadiationMemory {
     let db = &sys.db;
     match (sys.spec.irf.tail, &db.added_mass_inf) {
         (TailChoice::Fitted, Some(a_inf)) => {
             let fit = radiation::fit_tail(&db.omega_rad_s, b, &db.added_mass, a_inf, dt_s, duration_s);
-            Memory {
+            RadiationMemory {
                 irf: fit.irf,
                 tail: fit.tail,
                 fit_residuals: Some((fit.residual_cubic, fit.residual_fitted)),
@@ -97,7 +97,7 @@ pub fn memory_of(sys: &VesselSystem, b: &[DMatrix<f64>], dt_s: f64, duration_s: 
         }
         _ => {
             let tail = DampingTail::cubic(&db.omega_rad_s, b);
-            Memory {
+            RadiationMemory {
                 irf: radiation::impulse_response_of(&db.omega_rad_s, b, &tail, dt_s, duration_s),
                 tail,
                 fit_residuals: None,
@@ -150,13 +150,13 @@ pub fn state_space(
 
 /// The memory of the database as it is (its damping not made passive, so the checks see the BEM's
 /// data), with the configured (or default) time grid and damping tail.
-pub fn system_memory(sys: &VesselSystem) -> Memory {
+pub fn system_memory(sys: &VesselSystem) -> RadiationMemory {
     let dur = sys
         .spec
         .irf
         .duration_s
         .unwrap_or_else(|| radiation::default_duration_s(&sys.db));
-    memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, dur)
+    radiation_memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, dur)
 }
 
 /// The IRF of [`system_memory`].
@@ -204,7 +204,7 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
             negative_damping.push((i, ws));
         }
     }
-    let Memory {
+    let RadiationMemory {
         irf,
         tail,
         fit_residuals,

@@ -2,7 +2,7 @@
 
 use super::modal::ModalStep;
 use super::{Error, Result};
-use crate::hydro::check::{Memory, active_radiation, memory};
+use crate::hydro::check::{RadiationMemory, active_radiation, radiation_memory};
 use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation::{self, default_duration_s};
 use crate::hydro::system::AInfSource;
@@ -144,7 +144,7 @@ impl TimeModel {
             .memory_s
             .or(sys.spec.irf.duration_s)
             .unwrap_or_else(|| default_duration_s(&sys.db));
-        let Memory { irf: irf_all, tail, .. } = memory(sys, dt, memory_s);
+        let RadiationMemory { irf: irf_all, tail, .. } = radiation_memory(sys, dt, memory_s);
         // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
         // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
         // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
