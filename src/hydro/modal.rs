@@ -4,7 +4,7 @@
 //! Conventions: K(s) is the radiation kernel of the active DOFs (force on DOF i per velocity of DOF j,
 //! SI units: N/(m/s), N m/(rad/s), ...), K(iw) = B(w) + i w (A(w) - A_inf), strictly proper and symmetric.
 //!
-//! Pipeline (once per database, dt and speed):
+//! Pipeline (once per database and speed, on the system file's IRF grid: not per solver step):
 //! 1. Scaling: every entry is divided by sqrt(s_i s_j), s_i = max_w B_ii, so that DOFs of different units
 //!    weigh alike and the peak of every diagonal is 1.
 //! 2. Vector fitting (Gustavsen & Semlyen 1999, relaxed: Gustavsen 2006; fast QR form: Deschrijver et al.
