@@ -154,9 +154,10 @@ fn one_ship_time_domain_matches_its_floor_state_space() {
 /// A run of the forecaster from (x0, v0) with no past motion.
 /// Two ships (the pair demo, every DOF, full coupling), heading 150 deg, state space, dt 0.025 s: the
 /// time domain against its own floor. Measured 0.24 % (lighter sway at its 1.23 rad/s coupled
-/// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain: 1.09 %
-/// at the same resonance (before the database was symmetrized and the damping tail fitted: 1.8 %,
-/// lighter yaw at 0.65 rad/s), not asserted: see the convolution's test below.
+/// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain: 0.97 %
+/// at the same resonance (1.09 % when the model was refitted at each solver step; before the database
+/// was symmetrized and the damping tail fitted: 1.8 %, lighter yaw at 0.65 rad/s), not asserted: see
+/// the convolution's test below.
 #[test]
 fn two_ship_time_domain_matches_its_floor_state_space() {
     let (e, at) = td_against(
