@@ -458,9 +458,10 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
         writeln!(out, "  ... {} more pairs (--all-pairs)", kk.len() - shown)?;
     }
     let t_fit = std::time::Instant::now();
-    // as the time-domain model fits it: against Ogilvie's A_inf (consistent with the damping)
-    let a_inf_og = radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, &report.irf));
-    match check::state_space(sys, &a_inf_og, &report.tail) {
+    // the model the time domain runs: its memory (passive damping, the system's IRF grid) and A_inf
+    let mem = check::state_space_memory(sys);
+    let a_inf_model = check::model_a_inf(sys, &mem.irf);
+    match check::state_space(sys, &a_inf_model, &mem.tail) {
         Ok((ss, eb, ea)) => {
             let n_hsv = ss.hankel.len().min(ss.real_order() + 1);
             writeln!(

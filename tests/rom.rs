@@ -383,6 +383,35 @@ fn the_state_space_fit_does_not_depend_on_the_solver_step() {
     }
 }
 
+/// `db check` reports the state-space model the time domain runs (session 6 reported a fit to the raw
+/// damping: on RM3, whose BEM damping is not passive, 40 states and 1.98 % where the model has 32 and
+/// 0.87 %).
+#[test]
+fn db_check_reports_the_state_space_model_that_runs() {
+    let rel = "tests/data/wecsim-rm3/system.toml";
+    let (ok, out, err) = shipcast(&["db", "check", rel]);
+    assert!(ok, "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("state-space radiation"))
+        .unwrap_or_else(|| panic!("no state-space line in {out}"));
+    let reported: usize = line
+        .split("balanced-truncated to ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no order in {line}"));
+    let model = TimeModel::new(
+        &load(rel),
+        RomOptions {
+            radiation: RadiationMethod::StateSpace,
+            ..RomOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(reported, model.memory_size(), "{line}");
+}
+
 // ---- convergence in dt, and divergence reported ----
 
 #[test]

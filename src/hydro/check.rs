@@ -135,6 +135,26 @@ pub fn active_radiation(sys: &VesselSystem, a_inf: &DMatrix<f64>, tail: &Damping
     }
 }
 
+/// A_inf as the time-domain models use it: the database's when the system file asks for it, else
+/// Ogilvie's estimate from `irf` (consistent with the damping as the model sees it).
+pub fn model_a_inf(sys: &VesselSystem, irf: &Irf) -> DMatrix<f64> {
+    match (sys.spec.a_inf, &sys.db.added_mass_inf) {
+        (Some(AInfSource::Database), Some(a)) => a.clone(),
+        _ => radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, irf)),
+    }
+}
+
+/// The memory the state-space model is fitted from, as the time-domain model makes it: the passive
+/// damping on the system file's IRF grid (never the solver's step) and the configured memory length.
+pub fn state_space_memory(sys: &VesselSystem) -> RadiationMemory {
+    let dur = sys
+        .spec
+        .irf
+        .duration_s
+        .unwrap_or_else(|| radiation::default_duration_s(&sys.db));
+    radiation_memory(sys, sys.spec.irf.dt_s, dur)
+}
+
 /// The state-space fit of the active DOFs' radiation as the time-domain model makes it (see
 /// [`modal::fit`]), and its (damping, added mass) errors, the added mass against the given A_inf.
 pub fn state_space(

@@ -2,10 +2,9 @@
 
 use super::modal::ModalStep;
 use super::{Error, Result};
-use crate::hydro::check::{RadiationMemory, active_radiation, radiation_memory};
+use crate::hydro::check::{RadiationMemory, active_radiation, model_a_inf, radiation_memory};
 use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation::{self, default_duration_s};
-use crate::hydro::system::AInfSource;
 use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
 
@@ -156,10 +155,7 @@ impl TimeModel {
         // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
         // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
         // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
-        let a_inf_all = match (sys.spec.a_inf, &sys.db.added_mass_inf) {
-            (Some(AInfSource::Database), Some(a)) => a.clone(),
-            _ => radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, &irf_all)),
-        };
+        let a_inf_all = model_a_inf(sys, &irf_all);
         let terms = sys.linear_terms();
         let pad = |m: &DMatrix<f64>| sys.pad_states(m);
         let mut mass = sub(&(&terms.mass + pad(&a_inf_all)));
