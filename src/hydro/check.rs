@@ -147,12 +147,16 @@ pub fn model_a_inf(sys: &VesselSystem, irf: &Irf) -> DMatrix<f64> {
 /// The memory the state-space model is fitted from, as the time-domain model makes it: the passive
 /// damping on the system file's IRF grid (never the solver's step) and the configured memory length.
 pub fn state_space_memory(sys: &VesselSystem) -> RadiationMemory {
-    let dur = sys
-        .spec
+    radiation_memory(sys, sys.spec.irf.dt_s, memory_duration_s(sys))
+}
+
+/// The memory length the system file asks for (`irf.duration_s`), or the database's default
+/// ([`radiation::default_duration_s`]).
+pub fn memory_duration_s(sys: &VesselSystem) -> f64 {
+    sys.spec
         .irf
         .duration_s
-        .unwrap_or_else(|| radiation::default_duration_s(&sys.db));
-    radiation_memory(sys, sys.spec.irf.dt_s, dur)
+        .unwrap_or_else(|| radiation::default_duration_s(&sys.db))
 }
 
 /// The state-space fit of the active DOFs' radiation as the time-domain model makes it (see
@@ -171,12 +175,7 @@ pub fn state_space(
 /// The memory of the database as it is (its damping not made passive, so the checks see the BEM's
 /// data), with the configured (or default) time grid and damping tail.
 pub fn system_memory(sys: &VesselSystem) -> RadiationMemory {
-    let dur = sys
-        .spec
-        .irf
-        .duration_s
-        .unwrap_or_else(|| radiation::default_duration_s(&sys.db));
-    radiation_memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, dur)
+    radiation_memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, memory_duration_s(sys))
 }
 
 /// The IRF of [`system_memory`].

@@ -2,9 +2,9 @@
 
 use super::modal::ModalStep;
 use super::{Error, Result};
-use crate::hydro::check::{RadiationMemory, active_radiation, model_a_inf, radiation_memory};
+use crate::hydro::check::{RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory};
 use crate::hydro::modal::{ModalModel, ModalOptions};
-use crate::hydro::radiation::{self, default_duration_s};
+use crate::hydro::radiation;
 use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
 
@@ -143,10 +143,7 @@ impl TimeModel {
         // on the system file's IRF grid (`irf.dt_s`), so it, its tail and its A_inf do not move with the
         // solver's step (measured on the pair: refitted at each step, its floor was 1.9 % of peak off
         // the frequency domain at dt = 0.05 s and 3.3 % at 0.025 s, lighter yaw in beam seas at 0.05 rad/s)
-        let memory_s = opts
-            .memory_s
-            .or(sys.spec.irf.duration_s)
-            .unwrap_or_else(|| default_duration_s(&sys.db));
+        let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
         let irf_dt = match opts.radiation {
             RadiationMethod::StateSpace => sys.spec.irf.dt_s,
             _ => dt,
