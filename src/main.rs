@@ -459,7 +459,7 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     }
     let t_fit = std::time::Instant::now();
     // the model the time domain runs: its memory (passive damping, the system's IRF grid) and A_inf
-    let mem = check::state_space_memory(sys);
+    let mem = check::state_space_memory(sys, check::memory_duration_s(sys));
     let a_inf_model = check::model_a_inf(sys, &mem.irf);
     match check::state_space(sys, &a_inf_model, &mem.tail) {
         Ok((ss, eb, ea)) => {

@@ -151,7 +151,6 @@ fn one_ship_time_domain_matches_its_floor_state_space() {
     assert!(e <= TD_FLOOR_TOL, "{e} at {at}");
 }
 
-/// A run of the forecaster from (x0, v0) with no past motion.
 /// Two ships (the pair demo, every DOF, full coupling), heading 150 deg, state space, dt 0.025 s: the
 /// time domain against its own floor. Measured 0.24 % (lighter sway at its 1.23 rad/s coupled
 /// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain: 0.97 %
@@ -191,6 +190,7 @@ fn two_ship_floor_matches_frequency_domain_convolution() {
     assert!(e <= PAIR_FLOOR_TOL, "{e} at {at}");
 }
 
+/// A run of the forecaster from (x0, v0) with no past motion.
 fn run_from_rest_history(
     model: &TimeModel,
     x0: &[f64],

@@ -144,10 +144,10 @@ pub fn model_a_inf(sys: &VesselSystem, irf: &Irf) -> DMatrix<f64> {
     }
 }
 
-/// The memory the state-space model is fitted from, as the time-domain model makes it: the passive
-/// damping on the system file's IRF grid (never the solver's step) and the configured memory length.
-pub fn state_space_memory(sys: &VesselSystem) -> RadiationMemory {
-    radiation_memory(sys, sys.spec.irf.dt_s, memory_duration_s(sys))
+/// The memory the state-space model is fitted from (the time-domain model and `db check` both call
+/// this): the passive damping on the system file's IRF grid, never the solver's step.
+pub fn state_space_memory(sys: &VesselSystem, duration_s: f64) -> RadiationMemory {
+    radiation_memory(sys, sys.spec.irf.dt_s, duration_s)
 }
 
 /// The memory length the system file asks for (`irf.duration_s`), or the database's default

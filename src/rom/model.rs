@@ -2,7 +2,9 @@
 
 use super::modal::ModalStep;
 use super::{Error, Result};
-use crate::hydro::check::{RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory};
+use crate::hydro::check::{
+    RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
+};
 use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation;
 use crate::hydro::{HydroDb, VesselSystem};
@@ -144,11 +146,10 @@ impl TimeModel {
         // solver's step (measured on the pair: refitted at each step, its floor was 1.9 % of peak off
         // the frequency domain at dt = 0.05 s and 3.3 % at 0.025 s, lighter yaw in beam seas at 0.05 rad/s)
         let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
-        let irf_dt = match opts.radiation {
-            RadiationMethod::StateSpace => sys.spec.irf.dt_s,
-            _ => dt,
+        let RadiationMemory { irf: irf_all, tail, .. } = match opts.radiation {
+            RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
+            _ => radiation_memory(sys, dt, memory_s),
         };
-        let RadiationMemory { irf: irf_all, tail, .. } = radiation_memory(sys, irf_dt, memory_s);
         // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
         // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
         // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
