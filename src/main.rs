@@ -9,12 +9,17 @@ use shipcast::files;
 use shipcast::hydro::check::{self, mode_label};
 use shipcast::hydro::radiation;
 use shipcast::rao::FrequencySolver;
+use shipcast::rom::model::Kernel;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
-use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel, floor};
 use shipcast::scenario::{Scenario, prepare};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+/// `db check` warns when a radiation model's floor is off the database's frequency domain by more than
+/// this fraction of a curve's peak: the bar for the time domain against the frequency domain.
+const FLOOR_WARNING: f64 = 0.01;
 
 mod cli;
 
@@ -457,12 +462,23 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     if shown < kk.len() {
         writeln!(out, "  ... {} more pairs (--all-pairs)", kk.len() - shown)?;
     }
+    let mut warnings = sys.warnings.clone();
+    // the models the time domain runs, on the system file's IRF grid: the state-space fit's report,
+    // then each method's floor against the database's frequency domain
     let t_fit = std::time::Instant::now();
-    // the model the time domain runs: its memory (passive damping, the system's IRF grid) and A_inf
-    let mem = check::state_space_memory(sys, check::memory_duration_s(sys));
-    let a_inf_model = check::model_a_inf(sys, &mem.irf);
-    match check::state_space(sys, &a_inf_model, &mem.tail) {
-        Ok((ss, eb, ea)) => {
+    let model_opts = |radiation| RomOptions {
+        dt_s: sys.spec.irf.dt_s,
+        radiation,
+        ..RomOptions::default()
+    };
+    let ss_model = TimeModel::new(sys, model_opts(RadiationMethod::StateSpace));
+    match &ss_model {
+        Ok(TimeModel {
+            kernel: Kernel::StateSpace { model: ss, .. },
+            ..
+        }) => {
+            let mem = check::state_space_memory(sys, check::memory_duration_s(sys));
+            let (eb, ea) = check::state_space_errors(sys, ss, &check::model_a_inf(sys, &mem.irf), &mem.tail);
             let n_hsv = ss.hankel.len().min(ss.real_order() + 1);
             writeln!(
                 out,
@@ -480,9 +496,55 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
                 100.0 * ss.cover
             )?;
         }
-        Err(e) => writeln!(out, "state-space radiation: no fit: {}", e.0)?,
+        Ok(_) => writeln!(out, "state-space radiation: no radiating DOF")?,
+        Err(e) => writeln!(out, "state-space radiation: no fit: {e}")?,
     }
-    let mut warnings = sys.warnings.clone();
+    let (lo, hi) = db.omega_range();
+    let omegas: Vec<f64> = w.iter().copied().filter(|x| *x >= lo && *x <= hi).collect();
+    let fd = FrequencySolver::new(sys).table(&omegas, &db.heading_rad);
+    writeln!(
+        out,
+        "time-domain floor (the frequency-domain solve with the A(w), B(w) each radiation model implies: what a time-domain run converges to as dt -> 0) against the database's frequency domain; worst |difference| / curve peak, every mode and heading:"
+    )?;
+    for (name, model) in [
+        (
+            "convolution",
+            TimeModel::new(sys, model_opts(RadiationMethod::Convolution)),
+        ),
+        ("state space", ss_model),
+    ] {
+        let floor = model.and_then(|m| floor::implied_table(&m, &omegas, &db.heading_rad));
+        match (&fd, floor) {
+            (Ok(fd), Ok(floor)) => match floor::worst_curve_error(&floor, fd) {
+                Some(e) => {
+                    writeln!(
+                        out,
+                        "  {name:<12} {:.3} % ({}, heading {:.1} deg, {:.4} rad/s)",
+                        100.0 * e.fraction,
+                        mode_label(sys, e.state),
+                        db.heading_rad[e.heading].to_degrees(),
+                        omegas[e.omega]
+                    )?;
+                    if e.fraction > FLOOR_WARNING {
+                        let why = if name == "convolution" {
+                            "the database's A, B and A_inf are not Kramers-Kronig consistent enough there (see the table above: frequency resolution, range, panels)"
+                        } else {
+                            "the fit's error adds to the database's inconsistency (compare the convolution's floor)"
+                        };
+                        warnings.push(format!(
+                            "the {name} model's floor is {:.2} % of a curve's peak off the database's frequency domain ({} at {:.4} rad/s): no time step brings the time domain closer; {why}",
+                            100.0 * e.fraction,
+                            mode_label(sys, e.state),
+                            omegas[e.omega]
+                        ));
+                    }
+                }
+                None => writeln!(out, "  {name:<12} no response to compare")?,
+            },
+            (Err(e), _) => writeln!(out, "  {name:<12} no frequency-domain solve: {e}")?,
+            (_, Err(e)) => writeln!(out, "  {name:<12} no floor: {e}")?,
+        }
+    }
     for (i, ws) in &report.negative_damping {
         let peak = db.damping.iter().map(|b| b[(*i, *i)]).fold(0.0, f64::max);
         let (k, low) = db
@@ -772,20 +834,13 @@ fn rao(args: &RaoArgs) -> Result<()> {
         }
         None => sys.db.heading_rad.iter().map(|h| h.to_degrees()).collect(),
     };
+    let headings_rad: Vec<f64> = headings_deg.iter().map(|h| h.to_radians()).collect();
     let mut table: Vec<Vec<Vec<num_complex::Complex64>>> = vec![]; // [heading][omega][mode]
     match args.method {
         Method::Frequency => {
-            let solver = FrequencySolver::new(sys);
-            for &h in &headings_deg {
-                let mut rows = vec![];
-                for &w in &omegas {
-                    let xi = solver
-                        .rao(w, h.to_radians())
-                        .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?;
-                    rows.push(xi.iter().copied().collect());
-                }
-                table.push(rows);
-            }
+            table = FrequencySolver::new(sys)
+                .table(&omegas, &headings_rad)
+                .with_context(|| format!("{}", args.system.display()))?;
         }
         Method::Implied => {
             let opts = RomOptions {
@@ -794,18 +849,8 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 ..RomOptions::default()
             };
             let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
-            let kernels: Vec<_> = omegas.iter().map(|w| model.kernel_at(*w)).collect();
-            for &h in &headings_deg {
-                let mut rows = vec![];
-                for (&w, k) in omegas.iter().zip(&kernels) {
-                    rows.push(
-                        model
-                            .implied_rao_with(k, w, h.to_radians())
-                            .with_context(|| format!("{}: omega {w} rad/s, heading {h} deg", args.system.display()))?,
-                    );
-                }
-                table.push(rows);
-            }
+            table = shipcast::rom::floor::implied_table(&model, &omegas, &headings_rad)
+                .with_context(|| format!("{}", args.system.display()))?;
         }
         Method::Time => {
             let t0 = std::time::Instant::now();

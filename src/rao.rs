@@ -68,4 +68,22 @@ impl<'a> FrequencySolver<'a> {
         }
         Ok(out)
     }
+
+    /// [`FrequencySolver::rao`] at every heading and frequency: `table[heading][omega][state]` (the
+    /// layout of [`crate::rom::floor::RaoTable`]). An error names the heading and frequency.
+    pub fn table(&self, omegas_rad_s: &[f64], headings_rad: &[f64]) -> Result<Vec<Vec<Vec<Complex64>>>> {
+        headings_rad
+            .iter()
+            .map(|&h| {
+                omegas_rad_s
+                    .iter()
+                    .map(|&w| {
+                        self.rao(w, h).map(|x| x.iter().copied().collect()).map_err(|e| {
+                            Error::OutOfRange(format!("omega {w} rad/s, heading {} deg: {e}", h.to_degrees()))
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    }
 }

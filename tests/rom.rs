@@ -190,6 +190,55 @@ fn two_ship_floor_matches_frequency_domain_convolution() {
     assert!(e <= PAIR_FLOOR_TOL, "{e} at {at}");
 }
 
+/// The state-space model's floor for the pair, every mode and heading. Measured 1.895 % (lighter yaw in
+/// beam seas at 0.05 rad/s, where the convolution's floor is 0.53 % off: the fit's low-frequency added
+/// mass, see the state-space test above); 3.34 % at dt 0.025 when the fit still followed the solver's
+/// step. The 1 % is not met there: this guards what is.
+const PAIR_SS_FLOOR_TOL: f64 = 0.02;
+
+#[test]
+fn two_ship_floor_matches_frequency_domain_state_space() {
+    let (e, at) = rao_against(
+        "config/vessels/pair/system.toml",
+        "implied",
+        "state-space",
+        "frequency",
+        "0.05",
+        None,
+    );
+    assert!(e <= PAIR_SS_FLOOR_TOL, "{e} at {at}");
+}
+
+/// `db check` reports each radiation method's floor against the frequency domain by the tests' metric
+/// (its own implementation, `rom::floor`): the same figures as `rao --method implied` against `rao
+/// --method frequency` compared here, to the printed precision.
+#[test]
+fn db_check_reports_the_floors_the_rao_command_shows() {
+    let rel = "config/vessels/ship/system.toml";
+    let (ok, out, err) = shipcast(&["db", "check", rel]);
+    assert!(ok, "{err}");
+    for (label, radiation) in [("convolution", "convolution"), ("state space", "state-space")] {
+        let line = out
+            .lines()
+            .find(|l| l.trim_start().starts_with(label) && l.contains(" % ("))
+            .unwrap_or_else(|| panic!("no {label} floor in {out}"));
+        let reported: f64 = line
+            .trim_start()
+            .trim_start_matches(label)
+            .split_whitespace()
+            .next()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no figure in {line}"));
+        // the ship's IRF grid is the default 0.05 s, the step the convolution's floor is taken at
+        let (e, at) = rao_against(rel, "implied", radiation, "frequency", "0.05", None);
+        assert!(
+            (reported - 100.0 * e).abs() <= 0.0005 + 1e-9,
+            "{line} vs {:.4} % at {at}",
+            100.0 * e
+        );
+    }
+}
+
 /// A run of the forecaster from (x0, v0) with no past motion.
 fn run_from_rest_history(
     model: &TimeModel,

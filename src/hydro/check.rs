@@ -159,17 +159,16 @@ pub fn memory_duration_s(sys: &VesselSystem) -> f64 {
         .unwrap_or_else(|| radiation::default_duration_s(&sys.db))
 }
 
-/// The state-space fit of the active DOFs' radiation as the time-domain model makes it (see
-/// [`modal::fit`]), and its (damping, added mass) errors, the added mass against the given A_inf.
-pub fn state_space(
+/// The (damping, added mass) errors of a state-space model of the active DOFs' radiation (see
+/// [`modal::fit_errors`]), the added mass against the given A_inf.
+pub fn state_space_errors(
     sys: &VesselSystem,
+    model: &modal::ModalModel,
     a_inf: &DMatrix<f64>,
     tail: &DampingTail,
-) -> Result<(modal::ModalModel, f64, f64), modal::FitError> {
+) -> (f64, f64) {
     let r = active_radiation(sys, a_inf, tail);
-    let model = r.fit(&sys.db.omega_rad_s, modal::ModalOptions::default())?;
-    let (eb, ea) = modal::fit_errors(&model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf);
-    Ok((model, eb, ea))
+    modal::fit_errors(model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf)
 }
 
 /// The memory of the database as it is (its damping not made passive, so the checks see the BEM's
