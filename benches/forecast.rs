@@ -7,7 +7,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::files::load_system;
 use shipcast::rom::stepper::Stepper;
 use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel};
-use shipcast::scenario::{Scenario, prepare};
+use shipcast::scenario::{Scenario, past_options, prepare};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -33,7 +33,8 @@ fn benches(c: &mut Criterion) {
                 },
             )
             .expect("model");
-            let prep = prepare(&model, &sc.waves, sc.history_s).expect("spin-up");
+            let past = TimeModel::new(&sys, past_options(model.opts)).expect("past model");
+            let prep = prepare(&past, &model, &sc.waves, sc.history_s).expect("spin-up");
             let mut fc = Forecaster::new();
             let req = prep.request(300.0);
             g.bench_function(format!("{name}_{mname}"), |b| {

@@ -12,7 +12,7 @@ use shipcast::rao::FrequencySolver;
 use shipcast::rom::model::Kernel;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
 use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel, floor};
-use shipcast::scenario::{Scenario, prepare};
+use shipcast::scenario::{Scenario, past_options, prepare};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -606,7 +606,15 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
     let t_build = std::time::Instant::now();
     let model = TimeModel::new(sys, sc.opts).with_context(|| sc.system.display().to_string())?;
     let build_s = t_build.elapsed().as_secs_f64();
-    let prep = prepare(&model, &sc.waves, sc.history_s).context("spin-up of the history")?;
+    // the simulated measured past is the convolution's, whatever method forecasts
+    let past_opts = past_options(sc.opts);
+    let past = if past_opts == sc.opts {
+        None
+    } else {
+        Some(TimeModel::new(sys, past_opts).with_context(|| sc.system.display().to_string())?)
+    };
+    let prep =
+        prepare(past.as_ref().unwrap_or(&model), &model, &sc.waves, sc.history_s).context("spin-up of the history")?;
     let mut fc = Forecaster::new();
     let req = prep.request(sc.horizon_s);
     let mut times_ms = vec![];

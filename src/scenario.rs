@@ -1,6 +1,8 @@
 //! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and horizon. The
-//! measured past is simulated: the model runs from rest in the same sea for `history_s` (a spin-up whose
-//! velocities become the memory and whose end state is the state at t0), then forecasts `horizon_s`.
+//! measured past is simulated: a model runs from rest in the same sea for `history_s` (a spin-up whose
+//! velocities become the memory and whose end state is the state at t0), then the forecasting model
+//! forecasts `horizon_s`. The past is simulated by the reference (direct convolution) whatever method
+//! forecasts, as a measured past would not depend on it: the methods then differ only by their forecasts.
 
 use crate::files;
 use crate::rom::{self, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
@@ -246,22 +248,41 @@ impl Prepared {
     }
 }
 
-/// Runs the spin-up and returns the state, memory and waves at t0.
-pub fn prepare(model: &TimeModel, waves: &Waves, history_s: f64) -> rom::Result<Prepared> {
+/// The options of the model that simulates the measured past of a forecast made with `opts`: the
+/// reference, direct convolution, at the same step and speed.
+pub fn past_options(opts: RomOptions) -> RomOptions {
+    RomOptions {
+        radiation: RadiationMethod::Convolution,
+        ..opts
+    }
+}
+
+/// Runs the spin-up with `past` (the model that simulates the measured past) and returns the state,
+/// `model`'s memory of that past and the waves at t0. Both models must share the step and active DOFs.
+pub fn prepare(past: &TimeModel, model: &TimeModel, waves: &Waves, history_s: f64) -> rom::Result<Prepared> {
+    if past.opts.dt_s != model.opts.dt_s || past.active != model.active {
+        return Err(rom::Error::Input(format!(
+            "the past's model (dt {} s, {} active states) and the forecasting model (dt {} s, {} active states) differ",
+            past.opts.dt_s,
+            past.active.len(),
+            model.opts.dt_s,
+            model.active.len()
+        )));
+    }
     let waves = match waves {
         Waves::Sea(seas) => sea::realize_all(seas),
         Waves::Components(c) => c.clone(),
     };
     let n = model.n();
     let zeros = vec![0.0; n];
-    let memory = Memory::new(model);
+    let rest = Memory::new(past);
     let mut fc = Forecaster::new();
     let spin = fc.forecast(
-        model,
+        past,
         &ForecastRequest {
             x0: &zeros,
             v0: &zeros,
-            memory: &memory,
+            memory: &rest,
             waves: &waves,
             horizon_s: history_s,
             ramp_s: 30.0_f64.min(history_s / 2.0),

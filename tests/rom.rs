@@ -239,6 +239,55 @@ fn db_check_reports_the_floors_the_rao_command_shows() {
     }
 }
 
+/// The two radiation methods forecast the two-ship scenario (240 components, 300 s, dt 0.1 s) from the
+/// same simulated measured past (`scenario::prepare`: the convolution's spin-up): worst difference over
+/// the horizon / the convolution's peak. Measured: displacements of the modes with restoring (heave,
+/// roll, pitch) 0.09-0.31 %; every velocity 0.10-0.84 %. Surge, sway and yaw drift apart (lighter sway
+/// 13 %, 0.23 m in 300 s, a velocity offset of 0.8 mm/s): the state-space model's damping below the
+/// database's lowest frequency (passivity enforcement leaves about 4.5e3 N s/m on the lighter's sway
+/// where the database has about 0), printed here, not asserted.
+const FORECAST_AGREE_TOL: f64 = 0.005;
+const FORECAST_VELOCITY_AGREE_TOL: f64 = 0.01;
+
+#[test]
+fn two_ship_forecasts_from_the_same_past_agree() {
+    use shipcast::scenario::{Scenario, past_options, prepare};
+    let sc = Scenario::load(&repo("config/scenarios/two-ship.toml")).unwrap();
+    let sys = load_system(&sc.system).unwrap().system;
+    let model = |radiation| TimeModel::new(&sys, RomOptions { radiation, ..sc.opts }).unwrap();
+    let (cv, ss) = (model(RadiationMethod::Convolution), model(RadiationMethod::StateSpace));
+    let past = TimeModel::new(&sys, past_options(ss.opts)).unwrap();
+    let run = |m: &TimeModel| {
+        let prep = prepare(&past, m, &sc.waves, sc.history_s).unwrap();
+        Forecaster::new()
+            .forecast(m, &prep.request(sc.horizon_s))
+            .unwrap()
+            .clone()
+    };
+    let (fc, fs) = (run(&cv), run(&ss));
+    let nm = fc.n_modes;
+    for (r, &i) in cv.active.iter().enumerate() {
+        let worst = |a: &[f64], b: &[f64]| {
+            let peak = (0..=fc.steps).map(|k| a[k * nm + i].abs()).fold(0.0, f64::max);
+            let d = (0..=fc.steps)
+                .map(|k| (a[k * nm + i] - b[k * nm + i]).abs())
+                .fold(0.0, f64::max);
+            d / peak
+        };
+        let (ex, ev) = (worst(&fc.x, &fs.x), worst(&fc.v, &fs.v));
+        eprintln!(
+            "{}: displacement {:.3} %, velocity {:.3} %",
+            cv.labels[r],
+            100.0 * ex,
+            100.0 * ev
+        );
+        assert!(ev <= FORECAST_VELOCITY_AGREE_TOL, "{} velocity {ev}", cv.labels[r]);
+        if sys.stiffness()[(i, i)] > 0.0 {
+            assert!(ex <= FORECAST_AGREE_TOL, "{} displacement {ex}", cv.labels[r]);
+        }
+    }
+}
+
 /// A run of the forecaster from (x0, v0) with no past motion.
 fn run_from_rest_history(
     model: &TimeModel,
