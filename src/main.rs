@@ -496,7 +496,7 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
                 100.0 * ss.cover
             )?;
         }
-        Ok(_) => writeln!(out, "state-space radiation: no radiating DOF")?,
+        Ok(_) => writeln!(out, "state-space radiation: not built")?,
         Err(e) => writeln!(out, "state-space radiation: no fit: {e}")?,
     }
     let (lo, hi) = db.omega_range();
@@ -843,22 +843,20 @@ fn rao(args: &RaoArgs) -> Result<()> {
         None => sys.db.heading_rad.iter().map(|h| h.to_degrees()).collect(),
     };
     let headings_rad: Vec<f64> = headings_deg.iter().map(|h| h.to_radians()).collect();
-    let mut table: Vec<Vec<Vec<num_complex::Complex64>>> = vec![]; // [heading][omega][mode]
-    match args.method {
-        Method::Frequency => {
-            table = FrequencySolver::new(sys)
-                .table(&omegas, &headings_rad)
-                .with_context(|| format!("{}", args.system.display()))?;
-        }
+    let context = || args.system.display().to_string();
+    // [heading][omega][mode]
+    let table: floor::RaoTable = match args.method {
+        Method::Frequency => FrequencySolver::new(sys)
+            .table(&omegas, &headings_rad)
+            .with_context(context)?,
         Method::Implied => {
             let opts = RomOptions {
                 dt_s: args.dt,
                 radiation: args.radiation.into(),
                 ..RomOptions::default()
             };
-            let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
-            table = shipcast::rom::floor::implied_table(&model, &omegas, &headings_rad)
-                .with_context(|| format!("{}", args.system.display()))?;
+            let model = TimeModel::new(sys, opts).with_context(context)?;
+            floor::implied_table(&model, &omegas, &headings_rad).with_context(context)?
         }
         Method::Time => {
             let t0 = std::time::Instant::now();
@@ -868,7 +866,8 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 speed_m_s: args.speed,
                 ..RomOptions::default()
             };
-            let model = TimeModel::new(sys, opts).with_context(|| format!("{}", args.system.display()))?;
+            let model = TimeModel::new(sys, opts).with_context(context)?;
+            let mut table = vec![];
             for &h in &headings_deg {
                 let r = time_domain_rao(&model, h.to_radians(), &omegas, RegularOptions::default())
                     .with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
@@ -884,8 +883,9 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 omegas.len(),
                 t0.elapsed().as_secs_f64()
             );
+            table
         }
-    }
+    };
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     writeln!(out, "omega,heading_deg,mode,amplitude,phase_deg")?;
     for (iw, &w) in omegas.iter().enumerate() {
