@@ -47,14 +47,22 @@ pub fn worst_curve_error(test: &RaoTable, reference: &RaoTable) -> Option<CurveE
         return None;
     }
     let states = reference.first()?.first()?.len();
-    let curve_peak = |h: usize, s: usize| reference[h].iter().map(|row| row[s].norm()).fold(0.0, f64::max);
+    // curve_peak[h][s], and each state's largest over the headings
+    let curve_peak: Vec<Vec<f64>> = reference
+        .iter()
+        .map(|rows| {
+            (0..states)
+                .map(|s| rows.iter().map(|row| row[s].norm()).fold(0.0, f64::max))
+                .collect()
+        })
+        .collect();
     let state_peak: Vec<f64> = (0..states)
-        .map(|s| (0..reference.len()).map(|h| curve_peak(h, s)).fold(0.0, f64::max))
+        .map(|s| curve_peak.iter().map(|p| p[s]).fold(0.0, f64::max))
         .collect();
     let mut worst: Option<CurveError> = None;
     for (h, rows) in reference.iter().enumerate() {
         for s in 0..states {
-            let peak = curve_peak(h, s);
+            let peak = curve_peak[h][s];
             let scale = if peak >= SMALL_CURVE * state_peak[s] {
                 peak
             } else {
