@@ -426,6 +426,22 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
             ""
         }
     )?;
+    let repair = report.passivity_repair;
+    if repair.frequencies == 0 {
+        writeln!(
+            out,
+            "passivity (radiated power >= 0 makes B positive semi-definite): B(w) is, at every frequency"
+        )?;
+    } else {
+        writeln!(
+            out,
+            "passivity (radiated power >= 0 makes B positive semi-definite): B(w) indefinite at {} of {} frequencies; the models use it with the negative eigenvalues set to zero, largest change {:.4} % of sqrt(peak B_ii peak B_jj) at {:.4} rad/s",
+            repair.frequencies,
+            w.len(),
+            100.0 * repair.largest,
+            w[repair.at]
+        )?;
+    }
     let mut kk = report.kk.clone();
     kk.sort_by(|a, b| b.added_mass_band.total_cmp(&a.added_mass_band));
     let worst = |f: fn(&shipcast::hydro::radiation::PairError) -> f64| kk.iter().map(f).fold(0.0, f64::max);
@@ -573,6 +589,14 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
         warnings.push(format!(
             "A(w) or B(w) unsymmetric by up to {:.2} % of sqrt(X_ii X_jj): the two BEM estimates of a coupling disagree (panels too coarse?); a passive time-domain model follows only the symmetric part (tools/bem/make_db.py writes it)",
             100.0 * asym
+        ));
+    }
+    // the same bar as the asymmetry: a change of 1 % of a coupling's scale is a database problem
+    if repair.largest > 0.01 {
+        warnings.push(format!(
+            "B(w) far from positive semi-definite (up to {:.2} % of sqrt(peak B_ii peak B_jj) removed at {:.4} rad/s): the BEM radiates negative power there (irregular frequencies, panels too coarse?); the time-domain models see the repaired damping, the frequency domain the database's",
+            100.0 * repair.largest,
+            w[repair.at]
         ));
     }
     for n in &loaded.notes {

@@ -30,15 +30,17 @@ pub struct CheckReport {
     /// makes both symmetric; a panel method's are not, by its discretization error).
     pub asymmetry_added_mass: f64,
     pub asymmetry_damping: f64,
+    /// What making the database's damping passive changed (the time-domain models use the passive
+    /// damping; radiated power is never negative, a BEM's B(w) can be slightly indefinite).
+    pub passivity_repair: radiation::PassivityRepair,
 }
 
-/// max over w and i, j of |X_ij - X_ji| / sqrt(max_w |X_ii| max_w |X_jj|), over the DOFs whose peak is
-/// above 1e-9 of the largest (a DOF that does not radiate, like a spar's yaw, has a numerical-noise peak
-/// that would divide by nothing).
+/// max over w and i, j of |X_ij - X_ji| / sqrt(max_w |X_ii| max_w |X_jj|), over the DOFs that radiate
+/// ([`radiation::radiating_dofs`]: a spar's yaw has a numerical-noise peak that would divide by nothing).
 pub fn asymmetry(ms: &[DMatrix<f64>]) -> f64 {
     let peaks = radiation::diagonal_peaks(ms);
-    let top = peaks.iter().copied().fold(0.0, f64::max);
-    let live = |i: usize| peaks[i] > 1e-9 * top;
+    let radiating = radiation::radiating_dofs(&peaks);
+    let live = |i: usize| radiating[i];
     let mut worst = 0.0f64;
     for m in ms {
         for i in (0..m.nrows()).filter(|&i| live(i)) {
@@ -248,6 +250,7 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
         kk_ogilvie,
         asymmetry_added_mass: asymmetry(&db.added_mass),
         asymmetry_damping: asymmetry(&db.damping),
+        passivity_repair: radiation::passive_damping(&db.damping).1,
     }
 }
 

@@ -194,7 +194,14 @@ pub fn fit(
             "{nw} frequencies and {n} DOFs: a state-space fit needs at least 4 frequencies"
         )));
     }
-    let scale = super::radiation::diagonal_peaks(damping);
+    // a DOF that does not radiate (zero damping: see `radiation::passive_damping`) takes the smallest
+    // scale of one that does, so that nothing divides by zero
+    let peaks = super::radiation::diagonal_peaks(damping);
+    let top = peaks.iter().copied().fold(0.0, f64::max);
+    let scale: Vec<f64> = peaks
+        .iter()
+        .map(|p| p.max(super::radiation::NON_RADIATING * top))
+        .collect();
     let sc = |i: usize, j: usize| (scale[i] * scale[j]).sqrt();
     // the upper triangle, scaled: entry e = (i, j), data[e][k]
     let entries: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
@@ -244,6 +251,9 @@ pub fn fit(
                 .collect()
         })
         .collect();
+    if data.iter().flatten().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
+        return Err(FitError("the damping or added mass is not finite".into()));
+    }
     let set = Rows {
         freqs: &freqs,
         rows: &rows,

@@ -217,33 +217,72 @@ pub fn diagonal_peaks(ms: &[DMatrix<f64>]) -> Vec<f64> {
         .collect()
 }
 
-/// The database's damping made passive: at each frequency the symmetric part of B(w) is projected onto
-/// the positive semi-definite matrices (negative eigenvalues, from irregular frequencies or numerical
-/// noise, set to zero; eigen-decomposition in coordinates scaled by sqrt(max_w B_ii) so translations and
-/// rotations weigh alike). A passive B keeps every radiation model built from it from creating energy.
-/// Returns the damping and the largest change made, relative to the scale.
-pub fn passive_damping(damping: &[DMatrix<f64>]) -> (Vec<DMatrix<f64>>, f64) {
-    let Some(first) = damping.first() else {
-        return (vec![], 0.0);
-    };
-    let n = first.nrows();
-    let scale: Vec<f64> = diagonal_peaks(damping).into_iter().map(f64::sqrt).collect();
-    let mut worst = 0.0f64;
+/// A DOF whose peak damping is below this fraction of the largest DOF's does not radiate (a spar's yaw):
+/// its damping is numerical noise, which scaling by its own peak would blow up.
+pub const NON_RADIATING: f64 = 1e-9;
+
+/// Which DOFs radiate: peak damping (`diagonal_peaks`) above [`NON_RADIATING`] of the largest.
+pub fn radiating_dofs(peaks: &[f64]) -> Vec<bool> {
+    let top = peaks.iter().copied().fold(0.0, f64::max);
+    peaks.iter().map(|p| *p > NON_RADIATING * top).collect()
+}
+
+/// What [`passive_damping`] changed: how far a database's damping was from passive.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PassivityRepair {
+    /// Frequencies at which the symmetric part of B(w) had a negative eigenvalue.
+    pub frequencies: usize,
+    /// The largest change of an entry, relative to its scale sqrt(max_w B_ii max_w B_jj).
+    pub largest: f64,
+    /// The index of the frequency where it was made.
+    pub at: usize,
+}
+
+/// The database's damping made passive: at each frequency the symmetric part of B(w) over the DOFs that
+/// radiate ([`radiating_dofs`]) is projected onto the positive semi-definite matrices (negative
+/// eigenvalues, from irregular frequencies or numerical noise, set to zero; eigen-decomposition in
+/// coordinates scaled by sqrt(max_w B_ii) so translations and rotations weigh alike). The entries of a
+/// DOF that does not radiate, noise, are left as they are: in its own scale that noise is of order one
+/// and would move the others. A passive B keeps every radiation model built from it from creating
+/// energy (radiated power, v^T B v / 2, is never negative). Returns the damping and what was changed.
+pub fn passive_damping(damping: &[DMatrix<f64>]) -> (Vec<DMatrix<f64>>, PassivityRepair) {
+    let peaks = diagonal_peaks(damping);
+    let live: Vec<usize> = radiating_dofs(&peaks)
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.then_some(i))
+        .collect();
+    let n = live.len();
+    let scale: Vec<f64> = live.iter().map(|i| peaks[*i].sqrt()).collect();
+    let mut repair = PassivityRepair::default();
     let out = damping
         .iter()
-        .map(|b| {
-            let sym = DMatrix::from_fn(n, n, |i, j| 0.5 * (b[(i, j)] + b[(j, i)]) / (scale[i] * scale[j]));
+        .enumerate()
+        .map(|(k, b)| {
+            let (l, sc) = (&live, &scale);
+            let sym = DMatrix::from_fn(n, n, |i, j| 0.5 * (b[(l[i], l[j])] + b[(l[j], l[i])]) / (sc[i] * sc[j]));
             let eig = sym.clone().symmetric_eigen();
-            if eig.eigenvalues.iter().all(|l| *l >= 0.0) {
+            if eig.eigenvalues.iter().all(|v| *v >= 0.0) {
                 return b.clone();
             }
-            let clipped = eig.eigenvalues.map(|l| l.max(0.0));
+            let clipped = eig.eigenvalues.map(|v| v.max(0.0));
             let fixed = &eig.eigenvectors * DMatrix::from_diagonal(&clipped) * eig.eigenvectors.transpose();
-            worst = worst.max((&fixed - &sym).amax());
-            DMatrix::from_fn(n, n, |i, j| fixed[(i, j)] * scale[i] * scale[j])
+            let change = (&fixed - &sym).amax();
+            repair.frequencies += 1;
+            if change > repair.largest {
+                repair.largest = change;
+                repair.at = k;
+            }
+            let mut out = b.clone();
+            for i in 0..n {
+                for j in 0..n {
+                    out[(l[i], l[j])] = fixed[(i, j)] * sc[i] * sc[j];
+                }
+            }
+            out
         })
         .collect();
-    (out, worst)
+    (out, repair)
 }
 
 /// Default memory length: pi / (smallest frequency spacing), clamped to 30..600 s.
@@ -573,6 +612,31 @@ mod tests {
     use super::*;
     use crate::hydro::wamit::{Excitation, Radiation};
     use num_complex::Complex64;
+
+    #[test]
+    fn passive_damping_removes_only_the_negative_part_and_says_how_much() {
+        // DOF 0 in m/s, DOF 1 in rad/s (scales 4 and 9): at the second frequency the coupling 7 exceeds
+        // sqrt(4 * 9) = 6, an eigenvalue below zero
+        let ok = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, 9.0]);
+        let bad = DMatrix::from_row_slice(2, 2, &[4.0, 7.0, 7.0, 9.0]);
+        let (out, repair) = passive_damping(&[ok.clone(), bad.clone(), ok.clone()]);
+        assert_eq!(out[0], ok);
+        assert_eq!(out[2], ok);
+        assert_eq!((repair.frequencies, repair.at), (1, 1));
+        let lowest = out[1].clone().symmetric_eigen().eigenvalues.min();
+        assert!(lowest.abs() < 1e-12 * 9.0, "projected onto the boundary: {lowest}");
+        // scaled, [[1, 7/6], [7/6, 1]] has eigenvalues 13/6 and -1/6: clipping the latter changes every
+        // entry by 1/12
+        assert!((repair.largest - 1.0 / 12.0).abs() < 1e-12, "{repair:?}");
+        let (_, none) = passive_damping(std::slice::from_ref(&ok));
+        assert_eq!(none, PassivityRepair::default());
+        // a third DOF that does not radiate (a spar's yaw): its noise, indefinite in its own scale, is
+        // left alone and not counted as a repair
+        let noisy = DMatrix::from_row_slice(3, 3, &[4.0, 1.0, 1e-9, 1.0, 9.0, 0.0, 1e-9, 0.0, -1e-14]);
+        let (out, repair) = passive_damping(std::slice::from_ref(&noisy));
+        assert_eq!(repair, PassivityRepair::default());
+        assert_eq!(out[0], noisy);
+    }
 
     #[test]
     fn pl_weights_are_exact_for_linear_functions() {
