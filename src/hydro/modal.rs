@@ -1034,4 +1034,39 @@ mod tests {
         assert!(m.poles.iter().all(|p| p.re < 0.0));
         assert!(m.cover == 0.0, "passivity left to the cover: {}", m.cover);
     }
+
+    /// A DOF with no damping at all (one that does not radiate) is fitted as zero, not divided by its
+    /// zero scale; data that are not finite are refused (an SVD of NaN did not return).
+    #[test]
+    fn a_dof_without_damping_fits_as_zero_and_non_finite_data_are_refused() {
+        let ws: Vec<f64> = (1..=400).map(|i| i as f64 * 0.01).collect();
+        let h = |w: f64| {
+            let s = Complex64::new(0.0, w);
+            2.0 * 0.2 * s / (s * s + 2.0 * 0.2 * s + 1.0)
+        };
+        let b: Vec<DMatrix<f64>> = ws
+            .iter()
+            .map(|w| DMatrix::from_fn(2, 2, |i, j| if i + j == 0 { h(*w).re } else { 0.0 }))
+            .collect();
+        let a: Vec<DMatrix<f64>> = ws
+            .iter()
+            .map(|w| DMatrix::from_fn(2, 2, |i, j| if i + j == 0 { 1.0 + h(*w).im / w } else { 0.0 }))
+            .collect();
+        let ai = DMatrix::from_fn(2, 2, |i, j| if i + j == 0 { 1.0 } else { 0.0 });
+        let tail = DampingTail::cubic(&ws, &b);
+        let m = fit(&ws, &b, &a, &ai, &tail, ModalOptions::default()).expect("a fit");
+        for w in [0.1, 1.0, 3.0] {
+            let k = m.kernel(w);
+            assert!(k[(1, 1)].norm() < 1e-12 && k[(0, 1)].norm() < 1e-12, "w {w}: {k}");
+            assert!(
+                (k[(0, 0)] - h(w)).norm() < 0.01,
+                "w {w}: {} against {}",
+                k[(0, 0)],
+                h(w)
+            );
+        }
+        let mut bad = b.clone();
+        bad[7][(0, 0)] = f64::NAN;
+        assert!(fit(&ws, &bad, &a, &ai, &tail, ModalOptions::default()).is_err());
+    }
 }
