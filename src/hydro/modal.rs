@@ -194,8 +194,8 @@ pub fn fit(
             "{nw} frequencies and {n} DOFs: a state-space fit needs at least 4 frequencies"
         )));
     }
-    // a DOF that does not radiate (zero damping: see `radiation::passive_damping`) takes the smallest
-    // scale of one that does, so that nothing divides by zero
+    // a DOF that does not radiate (damping zero or noise: `radiation::radiating_dofs`) takes the
+    // smallest scale of one that does, so that nothing divides by zero
     let peaks = super::radiation::diagonal_peaks(damping);
     let top = peaks.iter().copied().fold(0.0, f64::max);
     let scale: Vec<f64> = peaks
