@@ -515,6 +515,9 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
                 100.0 * ea,
                 100.0 * ss.cover
             )?;
+            if let Ok(m) = &ss_model {
+                writeln!(out, "  {}", drift_drag_line(sys, m, ss))?;
+            }
         }
         Ok(_) => writeln!(out, "state-space radiation: not built")?,
         Err(e) => writeln!(out, "state-space radiation: no fit: {e}")?,
@@ -735,6 +738,43 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
         writeln!(out, "forecast_ms_median={median:.3} forecast_ms_p95={p95:.3}")?;
     }
     Ok(())
+}
+
+/// What `db check` says of the state-space model's damping at zero frequency: the largest over a DOF's
+/// peak damping, and the shortest time constant (M + A_inf)_ii / K_ii(0) of a DOF without restoring
+/// (a steady drift, which radiation does not damp, slowed down by the model).
+fn drift_drag_line(
+    sys: &shipcast::hydro::VesselSystem,
+    m: &TimeModel,
+    ss: &shipcast::hydro::modal::ModalModel,
+) -> String {
+    let k0 = ss.zero_frequency_damping();
+    let largest = (0..k0.len()).max_by(|&a, &b| (k0[a] / ss.scale[a]).abs().total_cmp(&(k0[b] / ss.scale[b]).abs()));
+    let free = (0..k0.len())
+        .filter(|&i| m.stiffness[(i, i)] == 0.0 && k0[i] > 0.0)
+        .map(|i| (i, m.mass[(i, i)] / k0[i]))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let mut line = String::from(
+        "damping at zero frequency (radiation has none; balanced truncation loses the fit's K(0) = 0 and passivity enforcement makes it positive):",
+    );
+    if let Some(i) = largest {
+        line += &format!(
+            " largest {:.4} % of the peak damping ({}, {:.3e} SI)",
+            100.0 * k0[i] / ss.scale[i],
+            mode_label(sys, m.active[i]),
+            k0[i]
+        );
+    }
+    match free {
+        Some((i, t)) => {
+            line += &format!(
+                "; a free drift slowed with time constant {t:.0} s at the shortest ({}, (M + A_inf) / K(0))",
+                mode_label(sys, m.active[i])
+            )
+        }
+        None => line += "; no DOF without restoring is damped at zero frequency",
+    }
+    line
 }
 
 /// The system file's external models, as `db check` prints them.

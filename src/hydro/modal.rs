@@ -141,6 +141,14 @@ impl ModalModel {
         }
         k
     }
+
+    /// The model's damping at zero frequency, Re K_ii(0) of each DOF in SI units: a drag on a steady
+    /// drift. Radiation has none (B(0) = 0; the fit keeps K(0) = 0 exactly), but balanced truncation
+    /// does not keep it and passivity enforcement then makes it positive.
+    pub fn zero_frequency_damping(&self) -> Vec<f64> {
+        let k = self.kernel(0.0);
+        (0..self.n).map(|i| k[(i, i)].re).collect()
+    }
 }
 
 pub fn is_real(p: Complex64) -> bool {
@@ -981,6 +989,35 @@ fn modal_form(a: &DMatrix<f64>, b: &DMatrix<f64>, c: &DMatrix<f64>) -> Result<Mo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Re K(0) worked by hand: a real mode g / (s + a) gives g / a; a complex one, 0.5 c^2 / (s - p) +
+    /// its conjugate, gives Re(-c^2 / p).
+    #[test]
+    fn zero_frequency_damping_is_the_kernel_at_zero() {
+        let (g, a): (f64, f64) = (3.0, 0.5);
+        let (c, p) = (Complex64::new(1.0, 0.5), Complex64::new(-0.2, 0.8));
+        let model = ModalModel {
+            n: 2,
+            poles: vec![Complex64::new(-a, 0.0), p],
+            // DOF-major: DOF 0 sees only the real mode, DOF 1 only the complex one
+            a: vec![
+                Complex64::new(g.sqrt(), 0.0),
+                Complex64::default(),
+                Complex64::default(),
+                c,
+            ],
+            scale: vec![1.0, 1.0],
+            cover: 0.0,
+            passivity_passes: 0,
+            fit_pairs: 0,
+            fit_error: 0.0,
+            full_order: 3,
+            hankel: vec![],
+        };
+        let k0 = model.zero_frequency_damping();
+        assert!((k0[0] - g / a).abs() < 1e-12, "{k0:?}");
+        assert!((k0[1] - (-c * c / p).re).abs() < 1e-12, "{k0:?}");
+    }
 
     /// A known passive 2 x 2 kernel, three band-pass terms with PSD gains (K(0) = 0, as radiation's):
     /// the fit, reduction and passivity enforcement reproduce it. Measured worst 2.0e-4 of the scale with
