@@ -509,6 +509,32 @@ fn db_check_reports_the_state_space_model_that_runs() {
     )
     .unwrap();
     assert_eq!(reported, model.memory_size(), "{line}");
+    // and its damping at zero frequency, the largest over a DOF's peak
+    let line = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("damping at zero frequency"))
+        .unwrap_or_else(|| panic!("no zero-frequency line in {out}"));
+    let reported: f64 = line
+        .split("largest ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no largest in {line}"));
+    let shipcast::rom::model::Kernel::StateSpace { model: ss, .. } = &model.kernel else {
+        panic!("not a state-space model");
+    };
+    let largest = ss
+        .zero_frequency_damping()
+        .iter()
+        .zip(&ss.scale)
+        .map(|(k, s)| (k / s).abs())
+        .fold(0.0, f64::max);
+    assert!(largest > 0.0, "{line}");
+    assert!(
+        (reported - 100.0 * largest).abs() < 1e-4,
+        "{line}: model {}",
+        100.0 * largest
+    );
 }
 
 // ---- convergence in dt, and divergence reported ----
