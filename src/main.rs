@@ -751,7 +751,7 @@ fn drift_drag_line(
     let k0 = ss.zero_frequency_damping();
     let largest = (0..k0.len()).max_by(|&a, &b| (k0[a] / ss.scale[a]).abs().total_cmp(&(k0[b] / ss.scale[b]).abs()));
     let free = (0..k0.len())
-        .filter(|&i| m.stiffness[(i, i)] == 0.0 && k0[i] > 0.0)
+        .filter(|&i| m.stiffness_linearized[(i, i)] == 0.0 && k0[i] > 0.0)
         .map(|i| (i, m.mass[(i, i)] / k0[i]))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     let mut line = String::from(

@@ -371,3 +371,34 @@ fn two_ships_moored_together_stay_stable_in_beam_seas_for_30_minutes() {
     );
     assert!(amp(2 * third, f.steps) < 1.5 * amp(third, 2 * third));
 }
+
+/// The implied RAO (the floor) linearizes lines and fenders at equilibrium as the frequency-domain solver
+/// does: with the radiation held at one frequency's A and B, the two are the same equations there. Before
+/// the fix the floor left the connections out: `db check` on the moored pair said 155 % (carrier sway).
+#[test]
+fn the_floor_of_a_moored_pair_linearizes_its_lines_and_fenders_as_the_frequency_domain() {
+    // round-off of two LU solves of the same 12 x 12 system
+    const SAME: f64 = 1e-9;
+    let sys = load_system(&repo("config/vessels/pair/moored.toml")).unwrap().system;
+    let fd = FrequencySolver::new(&sys);
+    for (w, heading_deg) in [(0.3, 90.0), (0.575, 90.0), (0.8, 180.0)] {
+        let model = TimeModel::new(
+            &sys,
+            RomOptions {
+                radiation: shipcast::rom::RadiationMethod::Constant { omega_rad_s: w },
+                ..RomOptions::default()
+            },
+        )
+        .unwrap();
+        let h = f64::to_radians(heading_deg);
+        let implied = model.implied_rao(w, h).unwrap();
+        let exact = fd.rao(w, h).unwrap();
+        let peak = exact.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        for (i, (a, b)) in implied.iter().zip(exact.iter()).enumerate() {
+            assert!(
+                (a - b).norm() <= SAME * peak,
+                "state {i} at {w} rad/s, heading {heading_deg}: implied {a}, frequency domain {b}"
+            );
+        }
+    }
+}

@@ -92,6 +92,9 @@ pub struct TimeModel {
     pub damping: DMatrix<f64>,
     /// C + C_UQ U^2 (with system-level entries).
     pub stiffness: DMatrix<f64>,
+    /// The same with the nonlinear connections (lines, fenders) linearized at equilibrium, as the
+    /// frequency-domain solver has them: the linear equations of the implied RAO (the floor).
+    pub stiffness_linearized: DMatrix<f64>,
     /// B_Q, when any entry is non-zero.
     pub quadratic: Option<DMatrix<f64>>,
     /// The nonlinear connections (mooring lines, fenders), when there are any.
@@ -247,6 +250,7 @@ impl TimeModel {
             ));
         }
         let external = sys.spec.external.has_nonlinear().then(|| sys.spec.external.clone());
+        let stiffness_linearized = &stiffness + sub(&sys.spec.external.nonlinear_tangent(sys.n_states()));
         let mut nl_offset = vec![0.0; sys.n_states()];
         if let Some(e) = &external {
             let z = vec![0.0; sys.n_states()];
@@ -276,6 +280,7 @@ impl TimeModel {
             mass_inv,
             damping,
             stiffness,
+            stiffness_linearized,
             quadratic,
             kernel,
             db: sys.db.clone(),
@@ -312,7 +317,8 @@ impl TimeModel {
     }
 
     /// The frequency-domain response of this time-domain model itself (the A and B implied by its
-    /// radiation memory, its A_inf, B_lin, C): the floor a time-domain run converges to as dt -> 0.
+    /// radiation memory, its A_inf, B_lin, C, the nonlinear connections linearized at equilibrium as the
+    /// frequency-domain solver has them): the floor a linear time-domain run converges to as dt -> 0.
     /// Every mode, inactive ones zero, per metre of wave amplitude, zero speed.
     pub fn implied_rao(&self, omega_rad_s: f64, heading_rad: f64) -> Result<Vec<num_complex::Complex64>> {
         self.implied_rao_with(&self.kernel_at(omega_rad_s), omega_rad_s, heading_rad)
@@ -334,7 +340,7 @@ impl TimeModel {
         let w = omega_rad_s;
         let z = DMatrix::from_fn(n, n, |i, j| {
             Complex64::new(
-                -w * w * self.mass[(i, j)] + self.stiffness[(i, j)],
+                -w * w * self.mass[(i, j)] + self.stiffness_linearized[(i, j)],
                 w * self.damping[(i, j)],
             ) + Complex64::new(0.0, w) * k[(i, j)]
         });
