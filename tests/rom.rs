@@ -490,16 +490,7 @@ fn db_check_reports_the_state_space_model_that_runs() {
     let rel = "tests/data/wecsim-rm3/system.toml";
     let (ok, out, err) = shipcast(&["db", "check", rel]);
     assert!(ok, "{err}");
-    let line = out
-        .lines()
-        .find(|l| l.starts_with("state-space radiation"))
-        .unwrap_or_else(|| panic!("no state-space line in {out}"));
-    let reported: usize = line
-        .split("balanced-truncated to ")
-        .nth(1)
-        .and_then(|r| r.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("no order in {line}"));
+    let reported: usize = number_after(&out, "state-space radiation", "balanced-truncated to ");
     let model = TimeModel::new(
         &load(rel),
         RomOptions {
@@ -508,18 +499,9 @@ fn db_check_reports_the_state_space_model_that_runs() {
         },
     )
     .unwrap();
-    assert_eq!(reported, model.memory_size(), "{line}");
+    assert_eq!(reported, model.memory_size());
     // and its damping at zero frequency, the largest over a DOF's peak
-    let line = out
-        .lines()
-        .find(|l| l.trim_start().starts_with("damping at zero frequency"))
-        .unwrap_or_else(|| panic!("no zero-frequency line in {out}"));
-    let reported: f64 = line
-        .split("largest ")
-        .nth(1)
-        .and_then(|r| r.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("no largest in {line}"));
+    let reported: f64 = number_after(&out, "damping at zero frequency", "largest ");
     let shipcast::rom::model::Kernel::StateSpace { model: ss, .. } = &model.kernel else {
         panic!("not a state-space model");
     };
@@ -529,12 +511,25 @@ fn db_check_reports_the_state_space_model_that_runs() {
         .zip(&ss.scale)
         .map(|(k, s)| (k / s).abs())
         .fold(0.0, f64::max);
-    assert!(largest > 0.0, "{line}");
+    assert!(largest > 0.0);
     assert!(
         (reported - 100.0 * largest).abs() < 1e-4,
-        "{line}: model {}",
+        "reported {reported} %, model {} %",
         100.0 * largest
     );
+}
+
+/// The number that follows `marker` on the line of `out` that starts (indentation aside) with `line_start`.
+fn number_after<T: std::str::FromStr>(out: &str, line_start: &str, marker: &str) -> T {
+    let line = out
+        .lines()
+        .find(|l| l.trim_start().starts_with(line_start))
+        .unwrap_or_else(|| panic!("no line starting {line_start:?} in {out}"));
+    line.split(marker)
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number after {marker:?} in {line}"))
 }
 
 // ---- convergence in dt, and divergence reported ----
