@@ -194,6 +194,10 @@ PRESETS["pair-2m"] = dict(PRESETS["pair"], panel_m=2.0)
 # 1.14 % at 1.23 rad/s (the tail beyond the data still decides it), and the state-space model needs 454
 # states (floor 18 %): not usable as it is.
 PRESETS["pair-wide-lid"] = _pair_to(0.02, lid_at_waterline=True)
+# the same on 2 m panels (an experiment, session 10, 1788 s): a spike at 1.76 rad/s the lids do not
+# remove (carrier pitch B 50 times its neighbours', A negative: Kramers-Kronig 129 % off there); below
+# 1.6 rad/s the convolution's floor is 1.18 % (carrier pitch at 0.81 rad/s): no better than 3 m panels.
+# Not usable.
 PRESETS["pair-fine-lid"] = _pair_to(0.02, panel_m=2.0, lid_at_waterline=True)
 
 
