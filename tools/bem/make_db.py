@@ -89,7 +89,8 @@ def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_
     # omega_max itself a spike (negative heave damping) remained at 1.525 rad/s on the 180 m hull, placed
     # for 1.25 omega_max it is gone (checked at 1.45-1.6 rad/s). NaN means no irregular frequency below
     # that bound for any lid depth: then put it just under the waterline. A preset may put it there anyway
-    # (`lid_at_waterline`): it then removes the irregular frequencies above 1.25 omega_max too.
+    # (`lid_at_waterline`), meant to remove the irregular frequencies above 1.25 omega_max too (on the 2 m
+    # pair a spike at 1.76 rad/s remained: `pair-fine-lid` below).
     z_lid = float(mesh.lowest_lid_position(1.25 * omega_max, g=G))
     if lid_at_waterline or not math.isfinite(z_lid) or z_lid > -0.05 * draft:
         z_lid = -0.05 * draft
@@ -184,14 +185,15 @@ PRESETS["pair-fine"] = _pair_to(0.02, panel_m=2.0)
 # 3 m panels 1.14 % at 1.23), the asymmetry grows to 8.5 % and the carrier's heave damping goes
 # negative at 1.58 rad/s (-25 % of its peak: an irregular frequency the lid does not remove): not usable.
 PRESETS["pair-2m"] = dict(PRESETS["pair"], panel_m=2.0)
-# the pair to 2.2 rad/s with the lids just under the waterline (5 % of the draft), where they remove
-# every irregular frequency, not only those below 1.25 omega_max (an experiment, session 10, 498 s): the
+# the pair to 2.2 rad/s with the lids just under the waterline (5 % of the draft), where they should
+# remove every irregular frequency, not only those below 1.25 omega_max (an experiment, session 10, 498 s): the
 # lighter's coupled resonance stops setting the convolution's floor: over 0.05-1.6 rad/s 0.80 % (lighter
 # roll at 0.5 rad/s, beam seas; the pair preset 1.14 % at 1.23 rad/s), 0.98 % over the whole range
 # (lighter yaw at 1.62). But 3 m panels are too coarse above 1.76 rad/s (panel radius > wavelength / 8):
 # B indefinite by 1.2 % at 1.72 rad/s, the lighter's roll damping negative at 2.02, heave A 8 % off its
 # Kramers-Kronig value at 1.72; the same data cut at 1.76 / 1.9 / 2.0 rad/s give floors of 0.97 / 1.16 /
-# 1.14 % at 1.23 rad/s (the tail beyond the data still decides it), and the state-space model needs 454
+# 1.14 % at 1.23 rad/s (the tail beyond the data still decides it; at 1.64 / 1.68 / 1.70 / 1.72 rad/s:
+# 1.10 / 1.32 / 1.31 / 1.04 %, the last three at the lighter's roll resonance), and the state-space model needs 454
 # states (floor 18 %): not usable as it is.
 PRESETS["pair-wide-lid"] = _pair_to(0.02, lid_at_waterline=True)
 # the same on 2 m panels (an experiment, session 10, 1788 s): a spike at 1.76 rad/s the lids do not
