@@ -493,10 +493,12 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
     };
     let ss_model = TimeModel::new(sys, model_opts(RadiationMethod::StateSpace));
     match &ss_model {
-        Ok(TimeModel {
-            kernel: Kernel::StateSpace { model: ss, .. },
-            ..
-        }) => {
+        Ok(
+            m @ TimeModel {
+                kernel: Kernel::StateSpace { model: ss, .. },
+                ..
+            },
+        ) => {
             let mem = check::state_space_memory(sys, check::memory_duration_s(sys));
             let (eb, ea) = check::state_space_errors(sys, ss, &check::model_a_inf(sys, &mem.irf), &mem.tail);
             let n_hsv = ss.hankel.len().min(ss.real_order() + 1);
@@ -515,9 +517,7 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
                 100.0 * ea,
                 100.0 * ss.cover
             )?;
-            if let Ok(m) = &ss_model {
-                writeln!(out, "  {}", drift_drag_line(sys, m, ss))?;
-            }
+            writeln!(out, "  {}", drift_drag_line(sys, m, ss))?;
         }
         Ok(_) => writeln!(out, "state-space radiation: not built")?,
         Err(e) => writeln!(out, "state-space radiation: no fit: {e}")?,
