@@ -190,12 +190,13 @@ fn two_ship_floor_matches_frequency_domain_convolution() {
     assert!(e <= PAIR_FLOOR_TOL, "{e} at {at}");
 }
 
-/// The state-space model's floor for the pair, every mode and heading. Measured 1.895 % (lighter yaw in
-/// beam seas at 0.05 rad/s, where the convolution's floor is 0.53 % off: a tiny curve driven by the
-/// couplings, which balanced truncation and, mostly, passivity enforcement move by about 1e-3 of their
-/// scale there); 3.34 % at dt 0.025 when the fit still followed the solver's step. The 1 % is
-/// not met there: this guards what is.
-const PAIR_SS_FLOOR_TOL: f64 = 0.02;
+/// The state-space model's floor for the pair, every mode and heading. Measured 1.366 % (lighter sway at
+/// its 1.23 rad/s resonance, head seas, where the convolution's floor is 1.14 %: the database's
+/// inconsistency); 1.895 % (lighter yaw in beam seas at 0.05 rad/s, a tiny curve driven by the couplings'
+/// added mass there) before passivity enforcement held the slow modes' residues (session 11: this test
+/// fails without that); 3.34 % at dt 0.025 when the fit still followed the solver's step. The issue's
+/// 1 % is not met at the resonance: this guards what is.
+const PAIR_SS_FLOOR_TOL: f64 = 0.015;
 
 #[test]
 fn two_ship_floor_matches_frequency_domain_state_space() {

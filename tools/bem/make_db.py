@@ -69,7 +69,7 @@ def wigley_mesh(length, beam, draft, nx, nz, a2=0.6, a4=1.0, kappa=1.0):
     return cpt.Mesh.from_list_of_faces(np.array(faces), name="wigley")
 
 
-def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_m, radii, lid_at_waterline=False):
+def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_m, radii, lid="lowest"):
     if hull == "wigley":
         nx = max(8, int(math.ceil(length / panel_m)))
         nz = max(3, int(math.ceil((draft + 0.5 * beam) / panel_m)))
@@ -84,16 +84,26 @@ def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_
     else:
         raise ValueError(f"unknown hull {hull}")
     mesh = mesh.translated(position)
-    # Lid against irregular frequencies. Capytaine's lowest_lid_position assumes a rectangular waterplane;
-    # a ship's narrows toward the ends, which lowers the irregular frequencies: with the lid placed for
-    # omega_max itself a spike (negative heave damping) remained at 1.525 rad/s on the 180 m hull, placed
-    # for 1.25 omega_max it is gone (checked at 1.45-1.6 rad/s). NaN means no irregular frequency below
-    # that bound for any lid depth: then put it just under the waterline. A preset may put it there anyway
-    # (`lid_at_waterline`), meant to remove the irregular frequencies above 1.25 omega_max too (on the 2 m
-    # pair a spike at 1.76 rad/s remained: `pair-fine-lid` below).
-    z_lid = float(mesh.lowest_lid_position(1.25 * omega_max, g=G))
-    if lid_at_waterline or not math.isfinite(z_lid) or z_lid > -0.05 * draft:
+    # Lid against irregular frequencies, where a preset asks for it (`lid`):
+    # - "lowest" (the default of the older presets): Capytaine's lowest_lid_position for 1.25 omega_max, or
+    #   5 % of the draft down where that is higher or undefined. lowest_lid_position is the deepest a lid
+    #   may go and assumes a rectangular waterplane; on the 180 m hull with the lid placed for omega_max
+    #   itself a spike (negative heave damping) remained at 1.525 rad/s, for 1.25 omega_max it was gone.
+    # - "waterline": 5 % of the draft down (session 10's experiments: a spike remained at 1.76 rad/s).
+    # - "surface": on the free surface, z = 0 (Capytaine's own default for generate_lid). Measured on the
+    #   carrier alone, 2 m panels (session 11): the 1.76 rad/s spike is gone, and a lid only 5 % of the
+    #   draft down still moved the smooth data well below it (heave damping at 1.6 rad/s 3.41e6 against
+    #   5.20e6 with the lid on the surface; 2.48e7 both at 0.5 rad/s).
+    if lid == "surface":
+        z_lid = 0.0
+    elif lid == "waterline":
         z_lid = -0.05 * draft
+    elif lid == "lowest":
+        z_lid = float(mesh.lowest_lid_position(1.25 * omega_max, g=G))
+        if not math.isfinite(z_lid) or z_lid > -0.05 * draft:
+            z_lid = -0.05 * draft
+    else:
+        raise ValueError(f"unknown lid placement {lid}")
     lid = mesh.generate_lid(z=z_lid, faces_max_radius=0.75 * panel_m)
     dofs = cpt.rigid_body_dofs(rotation_center=np.array(position, dtype=float))
     body = cpt.FloatingBody(mesh=mesh, lid_mesh=lid, dofs=dofs, name=name)
@@ -195,12 +205,17 @@ PRESETS["pair-2m"] = dict(PRESETS["pair"], panel_m=2.0)
 # 1.14 % at 1.23 rad/s (the tail beyond the data still decides it; at 1.64 / 1.68 / 1.70 / 1.72 rad/s:
 # 1.10 / 1.32 / 1.31 / 1.04 %, the last three at the lighter's roll resonance), and the state-space model needs 454
 # states (floor 18 %): not usable as it is.
-PRESETS["pair-wide-lid"] = _pair_to(0.02, lid_at_waterline=True)
+PRESETS["pair-wide-lid"] = _pair_to(0.02, lid="waterline")
 # the same on 2 m panels (an experiment, session 10, 1788 s): a spike at 1.76 rad/s the lids do not
 # remove (carrier pitch B 50 times its neighbours', A negative: Kramers-Kronig 129 % off there); below
 # 1.6 rad/s the convolution's floor is 1.18 % (carrier pitch at 0.81 rad/s): no better than 3 m panels.
 # Not usable.
-PRESETS["pair-fine-lid"] = _pair_to(0.02, panel_m=2.0, lid_at_waterline=True)
+PRESETS["pair-fine-lid"] = _pair_to(0.02, panel_m=2.0, lid="waterline")
+# the pair preset with the lids on the free surface (session 11)
+PRESETS["pair-surface-lid"] = dict(PRESETS["pair"], lid="surface")
+# the same to 2.2 rad/s, sampled at 0.005 rad/s from 0.8 rad/s up (the gap's resonances go on above 1.6)
+PRESETS["pair-wide-surface-lid"] = _pair_to(0.005, lid="surface")
+PRESETS["pair-fine-surface-lid"] = _pair_to(0.01, panel_m=2.0, lid="surface")
 
 
 
@@ -220,7 +235,7 @@ def main():
     omegas = np.asarray(p["omegas"], dtype=float)
     omega_max = float(omegas.max())
     built = [make_body(b["name"], b["hull"], b["length"], b["beam"], b["draft"], b["position"], p["panel_m"],
-                       omega_max, b["kg_m"], b["radii"], p.get("lid_at_waterline", False)) for b in p["bodies"]]
+                       omega_max, b["kg_m"], b["radii"], p.get("lid", "lowest")) for b in p["bodies"]]
     bodies = [b[0] for b in built]
     for (body, mass, cog, z_lid), spec in zip(built, p["bodies"]):
         m = mass_matrix(mass, cog - np.array(spec["position"]), spec["radii"])
