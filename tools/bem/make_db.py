@@ -211,9 +211,15 @@ PRESETS["pair-wide-lid"] = _pair_to(0.02, lid="waterline")
 # 1.6 rad/s the convolution's floor is 1.18 % (carrier pitch at 0.81 rad/s): no better than 3 m panels.
 # Not usable.
 PRESETS["pair-fine-lid"] = _pair_to(0.02, panel_m=2.0, lid="waterline")
-# the pair preset with the lids on the free surface (session 11)
+# the pair preset with the lids on the free surface (an experiment, session 11, 412 s): smooth data, but
+# less Kramers-Kronig consistent than the pair preset's (worst A 1.33 % in band, lighter heave at 0.965
+# rad/s) and the convolution's floor 1.51 % (the pair preset 1.14 %), both at the lighter's 1.23 rad/s
+# resonance; state space 4.85 % (lighter yaw, beam seas, 0.05 rad/s). Not usable.
 PRESETS["pair-surface-lid"] = dict(PRESETS["pair"], lid="surface")
-# the same to 2.2 rad/s, sampled at 0.005 rad/s from 0.8 rad/s up (the gap's resonances go on above 1.6)
+# the same to 2.2 rad/s, sampled at 0.005 rad/s from 0.8 rad/s up (the gap's resonances go on above 1.6;
+# an experiment, session 11, 838 s): no spike anywhere (no sample off the mean of its neighbours by 10 %
+# above 1.55 rad/s), but 3 m panels are coarse there (Capytaine warns above 1.755 rad/s) and the
+# convolution's floor is 8.3 % at the lighter's 1.23 rad/s resonance (7.7 % with the cubic tail). Not usable.
 PRESETS["pair-wide-surface-lid"] = _pair_to(0.005, lid="surface")
 PRESETS["pair-fine-surface-lid"] = _pair_to(0.01, panel_m=2.0, lid="surface")
 
