@@ -27,8 +27,9 @@
 //! 5. Passivity: the smallest eigenvalue of Re K_r(iw) (scaled) is found over a dense grid (uniform up to
 //!    4 x the highest database frequency, plus points within a few half-widths of every pole); where it
 //!    is negative the residues are perturbed (least-norm, slow modes held hardest: they set the added
-//!    mass at low frequency, see `enforce_passivity`); if it is still negative, -min is reported as `cover` and the time-domain model adds cover x diag(s) to its linear
-//!    damping, so the whole radiation + damping is dissipative at every frequency on that grid.
+//!    mass at low frequency, see `enforce_passivity`); if it is still negative, -min is reported as
+//!    `cover` and the time-domain model adds cover x diag(s) to its linear damping, so the whole
+//!    radiation + damping is dissipative at every frequency on that grid.
 //!
 //! Discretization over a step h with the input linear in time (first-order hold), exact for each mode:
 //! xi_{k+1} = E xi_k + g0 beta_k + g1 beta_{k+1}, E = exp(lambda h), g1 = (E - 1 - lambda h)/(lambda^2 h),
@@ -288,6 +289,8 @@ pub fn fit(
     let (ar, br, cr, hankel) = full.balanced_truncation(opts.reduction_tolerance);
     let (mpoles, mb, mc) = modal_form(&ar, &br, &cr)?;
     let grid = check_grid(&mpoles, wn);
+    // the middle of the database's band on a log scale (0.28 rad/s on the pair demo), so the choice
+    // scales with the database (a model-scale one has its frequencies higher by sqrt(scale))
     let low_band_rad_s = (omegas[0] * wn).sqrt();
     let (mb, mc, passes) = enforce_passivity(&mpoles, mb, mc, &grid, low_band_rad_s);
     let r = mpoles.len();
@@ -422,7 +425,7 @@ fn violations(
 /// response of a DOF without restoring is its mass there, so slow modes pay for that leverage.
 /// Measured on the pair demo (worst |difference| / curve peak of the state-space floor against the
 /// convolution's, lighter yaw in beam seas at 0.05 rad/s): 2.16 % with the share alone; w_low = 0.1 /
-/// 0.3 / 1 / 3 rad/s: 1.40 / 1.18 / 1.22 / 1.28 %.
+/// 0.3 / 1 / 3 rad/s: 1.40 / 1.18 / 1.22 / 1.28 % (the fit uses 0.28 rad/s there).
 fn enforce_passivity(
     poles: &[Complex64],
     mut b: DMatrix<Complex64>,
