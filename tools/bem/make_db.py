@@ -231,10 +231,10 @@ PRESETS["pair-wide-surface-lid"] = _pair_to(0.005, lid="surface")
 PRESETS["pair-fine-surface-lid"] = _pair_to(0.01, panel_m=2.0, lid="surface")
 # the pair preset solved with the direct (potential) formulation instead of the source one (an experiment,
 # session 12, 926 s): reciprocity holds better (largest asymmetry symmetrized away 1.8 % in A, 1.6 % in B;
-# the pair preset 3.0 / 4.1 %), the convolution's floor 0.84 % (lighter heave, beam
-# seas, 0.8 rad/s; 0.68 % at the lighter's 1.23 rad/s resonance), but the state space's 2.0 % (lighter
-# sway, heading 0, 0.05 rad/s; the pair preset 1.37 %), and with the database's own A_inf the convolution's
-# floor is 2.32 % at 1.23 rad/s (the pair preset 2.11 %): no more consistent there, only luckier. Not swapped in.
+# the pair preset 3.0 / 4.1 %), the convolution's floor 0.84 % (lighter heave, beam seas, 0.8 rad/s;
+# 0.68 % at the lighter's 1.23 rad/s resonance), but the state space's 2.0 % (lighter sway, heading 0,
+# 0.05 rad/s; the pair preset 1.37 %), and with the database's own A_inf the convolution's floor is 2.32 %
+# at 1.23 rad/s (the pair preset 2.11 %): no more consistent there, only luckier. Not swapped in.
 PRESETS["pair-direct"] = dict(PRESETS["pair"], bem_method="direct")
 # the pair preset with the Green function's singularities integrated for high frequencies (an experiment,
 # session 12, 886 s): Kramers-Kronig worst A 1.26 % in band (the pair preset 1.15 %), the convolution's floor
@@ -270,8 +270,8 @@ def main():
     system = bodies[0] if len(bodies) == 1 else cpt.Multibody(bodies)
     dof_names = list(system.dofs.keys())
     nmodes = len(dof_names)
-    # the older presets: Capytaine's defaults (the indirect, source formulation; the Green function's
-    # singularities integrated for low frequencies)
+    # unless a preset chooses otherwise (every preset before session 12), Capytaine's defaults: the indirect
+    # (source) formulation, the Green function's singularities integrated for low frequencies
     bem_method = p.get("bem_method", "indirect")
     gf_singularities = p.get("gf_singularities", "low_freq")
     solver = cpt.BEMSolver(green_function=cpt.Delhommeau(gf_singularities=gf_singularities), method=bem_method)
