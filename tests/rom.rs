@@ -191,8 +191,8 @@ fn two_ship_floor_matches_frequency_domain_convolution() {
 }
 
 /// The state-space model's floor for the pair, every mode and heading. Measured 1.367 % (lighter sway at
-/// its 1.23 rad/s resonance, head seas, where the convolution's floor is 1.14 %: the database's
-/// inconsistency); 1.895 % (lighter yaw in beam seas at 0.05 rad/s, a tiny curve driven by the couplings'
+/// its 1.23 rad/s resonance, following seas (heading 0), where the convolution's floor is 1.13 % and its
+/// worst, head seas, 1.14 %: the database's inconsistency); 1.895 % (lighter yaw in beam seas at 0.05 rad/s, a tiny curve driven by the couplings'
 /// added mass there) before passivity enforcement held the slow modes' residues (session 11: this test
 /// fails without that); 3.34 % at dt 0.025 when the fit still followed the solver's step. The issue's
 /// 1 % is not met at the resonance: this guards what is.
