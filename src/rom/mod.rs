@@ -27,6 +27,7 @@
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
 
+pub mod dense;
 pub mod floor;
 pub mod forecast;
 pub mod memory;

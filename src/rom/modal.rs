@@ -5,7 +5,13 @@
 //! the velocity is the input): xi_{k+1} = E xi_k + g0 beta_k + g1 beta_{k+1}, E = exp(lambda h),
 //! g1 = (E - 1 - lambda h) / (lambda^2 h), g0 = (E - 1) / lambda - g1 (series for small |lambda h|).
 //! The force is F = Re sum_j c_j xi_j.
+//!
+//! The stepper keeps the states one half-update ahead, with everything but the newest input
+//! (y_{k+1} = E xi_k + g0 beta_k, all the force at the new step needs before the new velocity is known),
+//! and moves them on in one pass per step ([`ModalStep::advance`]):
+//! y_{k+2} = E (y_{k+1} + g1 beta_{k+1}) + g0 beta_{k+1} = E y_{k+1} + h beta_{k+1}, h = E g1 + g0.
 
+use super::dense;
 use crate::hydro::modal::ModalModel;
 use multiversion::multiversion;
 use multiversion::target::target_cfg_f;
@@ -40,9 +46,16 @@ pub struct ModalStep {
     pub g0_im: Vec<f64>,
     pub g1_re: Vec<f64>,
     pub g1_im: Vec<f64>,
+    /// h = E g1 + g0: the new input's weight in the fused update ([`ModalStep::advance`]).
+    pub h_re: Vec<f64>,
+    pub h_im: Vec<f64>,
     /// DOF-major n x r.
     pub a_re: Vec<f64>,
     pub a_im: Vec<f64>,
+    /// The output map [Re A | -Im A] (n x 2r) column by column, columns padded to `n_pad` rows
+    /// ([`dense`]): F = this times the states (r real parts, then r imaginary parts).
+    pub n_pad: usize,
+    pub out_cols: Vec<f64>,
 }
 
 impl ModalStep {
@@ -67,9 +80,20 @@ impl ModalStep {
             g0_im: vec![0.0; r],
             g1_re: vec![0.0; r],
             g1_im: vec![0.0; r],
+            h_re: vec![0.0; r],
+            h_im: vec![0.0; r],
             a_re: padded(model.a.iter().map(|z| z.re).collect()),
             a_im: padded(model.a.iter().map(|z| z.im).collect()),
+            n_pad: dense::pad(n),
+            out_cols: vec![],
         };
+        d.out_cols = dense::columns(&DMatrix::from_fn(n, 2 * r, |i, c| {
+            if c < r {
+                d.a_re[i * r + c]
+            } else {
+                -d.a_im[i * r + c - r]
+            }
+        }));
         for (j, p) in model.poles.iter().enumerate() {
             let (e, g0, g1) = foh(*p, dt_s);
             d.e_re[j] = e.re;
@@ -78,6 +102,9 @@ impl ModalStep {
             d.g0_im[j] = g0.im;
             d.g1_re[j] = g1.re;
             d.g1_im[j] = g1.im;
+            let h = e * g1 + g0;
+            d.h_re[j] = h.re;
+            d.h_im[j] = h.im;
         }
         d
     }
@@ -112,9 +139,19 @@ impl ModalStep {
         absorb_kernel(self.r, &self.g1_re, &self.g1_im, xr, xi, br, bi);
     }
 
-    /// F = Re A xi into `out` (the first n entries).
-    pub fn output(&self, xr: &[f64], xi: &[f64], out: &mut [f64]) {
-        output_kernel(self.r, self.n, &self.a_re, &self.a_im, xr, xi, out);
+    /// F = Re A xi into `out` (the first n entries) from the states `x` (r real parts, then r
+    /// imaginary parts).
+    pub fn output(&self, x: &[f64], out: &mut [f64]) {
+        // the column-major product of [`dense`]: no horizontal sum per DOF
+        dense::gemv(self.n_pad, &self.out_cols, &x[..2 * self.r], &mut out[..self.n]);
+    }
+
+    /// The stepper's update, in one pass over the modes: from the states `x` held one half-update ahead
+    /// (E xi_k + g0 beta_k) and the new velocity `v`, the next such states (E x + h beta(v)), and the
+    /// force they give, F = Re A x, into `out` (the first n entries).
+    pub fn advance(&self, v: &[f64], x: &mut [f64], out: &mut [f64]) {
+        advance_kernel(self, v, x);
+        self.output(x, out);
     }
 
     /// The instantaneous matrix D = Re(A diag(g1) A^T): F_{k+1} = (known part) + D v_{k+1}.
@@ -145,18 +182,6 @@ pub const LANES: usize = 16;
 #[inline(always)]
 fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     if FMA { a.mul_add(b, c) } else { a * b + c }
-}
-
-/// sum a_j x_j over whole blocks of `LANES`.
-#[inline(always)]
-fn block_dot<const FMA: bool>(a: &[f64], x: &[f64]) -> f64 {
-    let mut acc = [0.0f64; LANES];
-    for (a, x) in a.chunks_exact(LANES).zip(x.chunks_exact(LANES)) {
-        for l in 0..LANES {
-            acc[l] = madd::<FMA>(a[l], x[l], acc[l]);
-        }
-    }
-    acc.iter().sum()
 }
 
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
@@ -210,15 +235,37 @@ fn absorb_kernel(r: usize, g_re: &[f64], g_im: &[f64], xr: &mut [f64], xi: &mut 
     }
 }
 
+/// beta = A^T v a block of modes at a time (as [`input_kernel`]), then x <- E x + h beta on the block
+/// while beta is in registers.
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
-fn output_kernel(r: usize, n: usize, a_re: &[f64], a_im: &[f64], xr: &[f64], xi: &[f64], out: &mut [f64]) {
+fn advance_kernel(s: &ModalStep, v: &[f64], x: &mut [f64]) {
     const FMA: bool = target_cfg_f!(target_feature = "fma");
-    let (xr, xi) = (&xr[..r], &xi[..r]);
-    // one plain dot product at a time: interleaving the real and imaginary products in one loop made
-    // the compiler shuffle 128-bit halves instead of packing
-    for (i, f) in out.iter_mut().enumerate().take(n) {
-        let row = i * r..(i + 1) * r;
-        *f = block_dot::<FMA>(&a_re[row.clone()], xr) - block_dot::<FMA>(&a_im[row], xi);
+    let (r, n) = (s.r, s.n);
+    let (xr, xi) = x[..2 * r].split_at_mut(r);
+    let v = &v[..n];
+    let (a_re, a_im) = (&s.a_re[..n * r], &s.a_im[..n * r]);
+    let (er, ei, hr, hi) = (&s.e_re[..r], &s.e_im[..r], &s.h_re[..r], &s.h_im[..r]);
+    for j in (0..r).step_by(LANES) {
+        let (mut br, mut bi) = ([0.0f64; LANES], [0.0f64; LANES]);
+        for (i, vi) in v.iter().enumerate() {
+            let (ar, ai) = (&a_re[i * r + j..i * r + j + LANES], &a_im[i * r + j..i * r + j + LANES]);
+            for l in 0..LANES {
+                br[l] = madd::<FMA>(ar[l], *vi, br[l]);
+                bi[l] = madd::<FMA>(ai[l], *vi, bi[l]);
+            }
+        }
+        let (xr, xi) = (&mut xr[j..j + LANES], &mut xi[j..j + LANES]);
+        let (er, ei, hr, hi) = (
+            &er[j..j + LANES],
+            &ei[j..j + LANES],
+            &hr[j..j + LANES],
+            &hi[j..j + LANES],
+        );
+        for l in 0..LANES {
+            let (a, b) = (xr[l], xi[l]);
+            xr[l] = er[l] * a - ei[l] * b + hr[l] * br[l] - hi[l] * bi[l];
+            xi[l] = er[l] * b + ei[l] * a + hr[l] * bi[l] + hi[l] * br[l];
+        }
     }
 }
 
@@ -247,8 +294,9 @@ mod tests {
         }
     }
 
-    /// The padded, dispatched kernels (input, propagate, absorb, output) equal the update written
-    /// directly in complex numbers, for a mode count that is not a whole number of blocks.
+    /// The padded, dispatched kernels (input, propagate, absorb, output, and the stepper's fused
+    /// advance) equal the update written directly in complex numbers, for a mode count that is not a
+    /// whole number of blocks and a DOF count that is not a whole number of output rows.
     #[test]
     fn kernels_equal_the_complex_update() {
         let (n, r) = (5, 21);
@@ -271,15 +319,27 @@ mod tests {
         let step = ModalStep::new(&model, h);
         assert_eq!(step.r % LANES, 0);
         let (mut x, mut beta) = (vec![0.0; 2 * step.r], vec![0.0; 2 * step.r]);
+        // the stepper's fused form, one half-update ahead (E xi + g0 beta)
+        let mut y = vec![0.0; 2 * step.r];
         let mut xi = vec![Complex64::default(); r];
         let mut b_prev = vec![Complex64::default(); r];
-        let mut out = vec![0.0; n];
+        let (mut out, mut out_y) = (vec![0.0; n], vec![0.0; n]);
         for k in 0..30 {
             let v: Vec<f64> = (0..n).map(|i| wave(k * n + i, 0.37)).collect();
             step.feed(&mut x, &mut beta, &v, k > 0);
+            if k == 0 {
+                y.copy_from_slice(&x);
+                let (yr, yi) = y.split_at_mut(step.r);
+                let (br, bi) = beta.split_at_mut(step.r);
+                step.propagate(yr, yi, br, bi);
+                step.output(&y, &mut out_y);
+            } else {
+                step.advance(&v, &mut y, &mut out_y);
+            }
             let b: Vec<Complex64> = (0..r)
                 .map(|j| (0..n).map(|i| model.a[i * r + j] * v[i]).sum())
                 .collect();
+            let mut ahead = vec![Complex64::default(); r];
             for j in 0..r {
                 let (e, g0, g1) = foh(model.poles[j], h);
                 // at rest before the first sample: the state at it is zero
@@ -288,16 +348,18 @@ mod tests {
                 } else {
                     Complex64::default()
                 };
+                ahead[j] = e * xi[j] + g0 * b[j];
             }
             b_prev = b;
-            let (xr, xim) = x.split_at(step.r);
-            step.output(xr, xim, &mut out);
-            for (i, f) in out.iter().enumerate() {
-                let want: f64 = (0..r).map(|j| (model.a[i * r + j] * xi[j]).re).sum();
-                assert!(
-                    (f - want).abs() <= 1e-12 * (1.0 + want.abs()),
-                    "step {k}, DOF {i}: {f} vs {want}"
-                );
+            step.output(&x, &mut out);
+            for i in 0..n {
+                for (what, got, states) in [("state", out[i], &xi), ("fused, ahead", out_y[i], &ahead)] {
+                    let want: f64 = (0..r).map(|j| (model.a[i * r + j] * states[j]).re).sum();
+                    assert!(
+                        (got - want).abs() <= 1e-12 * (1.0 + want.abs()),
+                        "{what}, step {k}, DOF {i}: {got} vs {want}"
+                    );
+                }
             }
         }
     }

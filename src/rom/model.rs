@@ -104,11 +104,12 @@ pub struct TimeModel {
     /// Number of active body DOFs: they come first in `active`, the tank states after them.
     pub n_hydro: usize,
     pub kernel: Kernel,
-    /// The step's matrices, row-major for its inner loop: B + D (D the instantaneous radiation matrix,
-    /// F_rad(t_k+1) = P + D v_k+1), C, and S^-1 = [M + dt/2 (B + D) + beta dt^2 C]^-1.
-    pub rows_bd: Vec<f64>,
-    pub rows_c: Vec<f64>,
-    pub rows_s_inv: Vec<f64>,
+    /// The step's matrices, column by column with columns padded to `n_pad` rows for its inner loop
+    /// ([`super::dense`]): [B + D | C] (n x 2n; D the instantaneous radiation matrix,
+    /// F_rad(t_k+1) = P + D v_k+1) and S^-1 = [M + dt/2 (B + D) + beta dt^2 C]^-1.
+    pub n_pad: usize,
+    pub cols_bdc: Vec<f64>,
+    pub cols_s_inv: Vec<f64>,
     /// The database (for the excitation), with the system's g and depth.
     pub db: HydroDb,
     pub g_m_s2: f64,
@@ -260,15 +261,13 @@ impl TimeModel {
             .iter()
             .map(|&i| crate::hydro::check::mode_label(sys, i))
             .collect();
-        let (rows_bd, rows_c, rows_s_inv) = (
-            row_major(&(&damping + &d_inst)),
-            row_major(&stiffness),
-            row_major(&s_inv),
-        );
+        let mut bdc = DMatrix::zeros(n, 2 * n);
+        bdc.view_mut((0, 0), (n, n)).copy_from(&(&damping + &d_inst));
+        bdc.view_mut((0, n), (n, n)).copy_from(&stiffness);
         Ok(TimeModel {
-            rows_bd,
-            rows_c,
-            rows_s_inv,
+            n_pad: super::dense::pad(n),
+            cols_bdc: super::dense::columns(&bdc),
+            cols_s_inv: super::dense::columns(&s_inv),
             n_modes: sys.n_states(),
             n_hydro: nh,
             external,
@@ -403,9 +402,4 @@ impl TimeModel {
             Kernel::StateSpace { model, .. } => model.real_order(),
         }
     }
-}
-
-/// The entries of `m` row by row.
-fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
-    m.transpose().as_slice().to_vec()
 }

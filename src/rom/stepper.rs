@@ -2,6 +2,7 @@
 //! radiation force split into a known part and an implicit instantaneous part (see [`super`]).
 //! The stepper owns only reusable workspace; what it reads comes in as arguments.
 
+use super::dense;
 use super::memory::Memory;
 use super::model::{Kernel, NlScratch, TimeModel};
 use super::{Error, Result};
@@ -23,14 +24,17 @@ pub struct Stepper {
     pub k: usize,
     /// Convolution: velocities in reverse time order; v_k at (capacity - k) n, history after v_0.
     buf: Vec<f64>,
-    /// State space: the modes' states (r real parts, then r imaginary parts) and their input b . v at
-    /// the current step, laid out alike.
+    /// State space: the modes' states (r real parts, then r imaginary parts), held one half-update
+    /// ahead during a run (see [`super::modal`]), and their input b . v at the start, laid out alike.
     states: Vec<f64>,
     beta: Vec<f64>,
-    // scratch
-    xt: Vec<f64>,
-    vt: Vec<f64>,
+    /// State space: the radiation force the states give at the next step (all but the new velocity's).
+    rad_next: Vec<f64>,
+    // scratch; `zt` is the predictor, velocities then displacements (one product with [B + D | C])
+    zt: Vec<f64>,
+    lin: Vec<f64>,
     rhs: Vec<f64>,
+    a_try: Vec<f64>,
     p: Vec<f64>,
     fnl: Vec<f64>,
     a_new: Vec<f64>,
@@ -67,9 +71,10 @@ impl Stepper {
                 &mut self.x,
                 &mut self.v,
                 &mut self.a,
-                &mut self.xt,
-                &mut self.vt,
+                &mut self.rad_next,
+                &mut self.lin,
                 &mut self.rhs,
+                &mut self.a_try,
                 &mut self.p,
                 &mut self.fnl,
                 &mut self.a_new,
@@ -79,6 +84,7 @@ impl Stepper {
             ] {
                 v.resize(n, 0.0);
             }
+            self.zt.resize(2 * n, 0.0);
             self.buf = vec![0.0; if taps > 0 { (steps + taps) * n } else { 0 }];
         }
         if let Kernel::StateSpace { step, .. } = &model.kernel {
@@ -145,8 +151,13 @@ impl Stepper {
                 self.states.copy_from_slice(states);
                 self.beta.copy_from_slice(beta);
                 step.feed(&mut self.states, &mut self.beta, v0, *started);
-                let (xr, xi) = self.states.split_at(step.r);
-                step.output(xr, xi, &mut frad);
+                step.output(&self.states, &mut frad);
+                // one half-update ahead for the first step: E xi_0 + g0 beta_0, and its force
+                let (xr, xi) = self.states.split_at_mut(step.r);
+                let (br, bi) = self.beta.split_at_mut(step.r);
+                step.propagate(xr, xi, br, bi);
+                self.rad_next.iter_mut().for_each(|f| *f = 0.0);
+                step.output(&self.states, &mut self.rad_next);
             }
             _ => return Err(Error::Input("memory and model use different radiation methods".into())),
         }
@@ -176,7 +187,7 @@ impl Stepper {
 }
 
 /// [`Stepper::step`], compiled for AVX2 + FMA as well as the baseline and chosen at run time: its
-/// short loops over the DOFs are a quarter of a state-space forecast.
+/// short loops over the DOFs were a fifth of a state-space forecast.
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn step_dispatched(st: &mut Stepper, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
     st.step_body(model, f1, known, direct_from)
@@ -202,21 +213,18 @@ impl Stepper {
                     self.p[i] = known[i] + dot(row, &self.buf[start..start + mcount * n]);
                 }
             }
-            Kernel::StateSpace { step, .. } => {
-                // the states with everything but the new input: E xi + g0 beta_k
-                self.p.iter_mut().for_each(|p| *p = 0.0);
-                let r = step.r;
-                let (xr, xi) = self.states.split_at_mut(r);
-                let (br, bi) = self.beta.split_at_mut(r);
-                step.propagate(xr, xi, br, bi);
-                step.output(xr, xi, &mut self.p);
-            }
+            // the states hold everything but the new input (E xi + g0 beta_k): their force, computed
+            // when they were
+            Kernel::StateSpace { .. } => self.p.copy_from_slice(&self.rad_next),
         }
         // predictor
         for i in 0..n {
-            self.xt[i] = self.x[i] + dt * self.v[i] + dt * dt * (0.5 - beta) * self.a[i];
-            self.vt[i] = self.v[i] + 0.5 * dt * self.a[i];
+            self.zt[n + i] = self.x[i] + dt * self.v[i] + dt * dt * (0.5 - beta) * self.a[i];
+            self.zt[i] = self.v[i] + 0.5 * dt * self.a[i];
         }
+        let np = model.n_pad;
+        // (B + D) vt + C xt: it does not change between the passes
+        dense::gemv(np, &model.cols_bdc, &self.zt, &mut self.lin);
         // nonlinear forces at the state the new acceleration implies: fixed-point passes starting from
         // a_{k+1} = a_k (they contract fast: the step matrix S is dominated by the mass)
         let nonlinear = model.is_nonlinear();
@@ -228,21 +236,18 @@ impl Stepper {
         loop {
             if nonlinear {
                 for i in 0..n {
-                    self.v_pred[i] = self.vt[i] + 0.5 * dt * self.a_new[i];
-                    self.x_pred[i] = self.xt[i] + beta * dt * dt * self.a_new[i];
+                    self.v_pred[i] = self.zt[i] + 0.5 * dt * self.a_new[i];
+                    self.x_pred[i] = self.zt[n + i] + beta * dt * dt * self.a_new[i];
                 }
                 model.nonlinear_force(&self.x_pred, &self.v_pred, &mut self.fnl, &mut self.nl);
             }
             for i in 0..n {
-                let row = i * n..(i + 1) * n;
-                self.rhs[i] = f1[i]
-                    - self.p[i]
-                    - self.fnl[i]
-                    - small_dot2(&model.rows_bd[row.clone()], &self.vt, &model.rows_c[row], &self.xt);
+                self.rhs[i] = f1[i] - self.p[i] - self.fnl[i] - self.lin[i];
             }
+            dense::gemv(np, &model.cols_s_inv, &self.rhs, &mut self.a_try);
             let (mut change, mut size) = (0.0f64, 0.0f64);
             for i in 0..n {
-                let a = small_dot2(&model.rows_s_inv[i * n..(i + 1) * n], &self.rhs, &[], &[]);
+                let a = self.a_try[i];
                 change = change.max((a - self.a_new[i]).abs());
                 size = size.max(a.abs());
                 self.a_new[i] = a;
@@ -253,8 +258,8 @@ impl Stepper {
             }
         }
         for i in 0..n {
-            self.x[i] = self.xt[i] + beta * dt * dt * self.a_new[i];
-            self.v_new[i] = self.vt[i] + 0.5 * dt * self.a_new[i];
+            self.x[i] = self.zt[n + i] + beta * dt * dt * self.a_new[i];
+            self.v_new[i] = self.zt[i] + 0.5 * dt * self.a_new[i];
             self.a[i] = self.a_new[i];
         }
         // memory
@@ -263,13 +268,7 @@ impl Stepper {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
             }
-            Kernel::StateSpace { step, .. } => {
-                let r = step.r;
-                let (xr, xi) = self.states.split_at_mut(r);
-                let (br, bi) = self.beta.split_at_mut(r);
-                step.input(&self.v_new, br, bi);
-                step.absorb(xr, xi, br, bi);
-            }
+            Kernel::StateSpace { step, .. } => step.advance(&self.v_new, &mut self.states, &mut self.rad_next),
         }
         std::mem::swap(&mut self.v, &mut self.v_new);
         self.k = k1;
@@ -313,28 +312,4 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
         s += x * y;
     }
     s
-}
-
-/// a . x + b . y for the step's short rows (n DOFs): four accumulators, so rows of 4, 8, 12 DOFs have
-/// no scalar tail (the eight-wide [`dot`] left a tail of four on the two-ship model).
-#[inline]
-fn small_dot2(a: &[f64], x: &[f64], b: &[f64], y: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let mut tail = 0.0;
-    for (a, x) in [(a, x), (b, y)] {
-        let n = a.len().min(x.len());
-        let (ca, cx) = (a[..n].chunks_exact(4), x[..n].chunks_exact(4));
-        tail += ca
-            .remainder()
-            .iter()
-            .zip(cx.remainder())
-            .map(|(a, x)| a * x)
-            .sum::<f64>();
-        for (a, x) in ca.zip(cx) {
-            for l in 0..4 {
-                acc[l] += a[l] * x[l];
-            }
-        }
-    }
-    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
 }
