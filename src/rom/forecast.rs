@@ -179,8 +179,11 @@ impl Forecaster {
         }
         let steps = (req.horizon_s / dt).round() as usize;
         self.wave_force(model, req.waves, steps, req.ramp_s)?;
+        // the known radiation part: the convolution's only (the modal states carry their own past)
         self.known.clear();
-        self.known.resize((steps + 1) * n, 0.0);
+        if matches!(model.kernel, Kernel::Convolution { .. }) {
+            self.known.resize((steps + 1) * n, 0.0);
+        }
         if let (Kernel::Convolution { .. }, Memory::Convolution { len, .. }) = (&model.kernel, req.memory)
             && (*len > 0 || req.v0.iter().any(|v| *v != 0.0))
         {
@@ -193,12 +196,15 @@ impl Forecaster {
         self.out.dt_s = dt;
         self.out.n_modes = nm;
         self.out.steps = steps;
-        self.out.x.clear();
-        self.out.x.resize((steps + 1) * nm, 0.0);
-        self.out.v.clear();
-        self.out.v.resize((steps + 1) * nm, 0.0);
-        self.out.a.clear();
-        self.out.a.resize((steps + 1) * nm, 0.0);
+        // every entry is written below when every state is active: zeroed only otherwise
+        let all_active = n == nm;
+        for out in [&mut self.out.x, &mut self.out.v, &mut self.out.a] {
+            if !all_active {
+                out.clear();
+            }
+            out.resize((steps + 1) * nm, 0.0);
+            out.truncate((steps + 1) * nm);
+        }
         for (r, &i) in model.active.iter().enumerate() {
             self.out.x[i] = req.x0[r];
             self.out.v[i] = req.v0[r];
@@ -208,7 +214,7 @@ impl Forecaster {
         let mut direct_from = 1;
         for k in 1..=steps {
             let f = &self.force[k * n..(k + 1) * n];
-            let kn = &self.known[k * n..(k + 1) * n];
+            let kn = self.known.get(k * n..(k + 1) * n).unwrap_or(&[]);
             self.stepper.step(model, f, kn, direct_from)?;
             for (r, &i) in model.active.iter().enumerate() {
                 self.out.x[k * nm + i] = self.stepper.x[r];

@@ -10,7 +10,8 @@
 //! Cost: components x outputs x (2 SPREAD + 1) plus one FFT of R len per pair of outputs, against
 //! components x outputs x len for the direct sum. Only the real part is wanted, so two outputs share
 //! one FFT: Re(IFFT g) = IFFT of g's Hermitian part (g_j + conj g_-j) / 2, whose transform is real,
-//! and IFFT(h1 + i h2) = Re(IFFT g1) + i Re(IFFT g2).
+//! and IFFT(h1 + i h2) = Re(IFFT g1) + i Re(IFFT g2); the Hermitian parts are spread directly (each
+//! component at its points and, conjugated, at their mirror images).
 
 use num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
@@ -27,7 +28,6 @@ pub struct Sinusoids {
     len_grid: usize,
     inverse: Option<Arc<dyn Fft<f64>>>,
     grid: Vec<Complex64>,
-    grid2: Vec<Complex64>,
     scratch: Vec<Complex64>,
     weights: Vec<f64>,
     first: Vec<isize>,
@@ -69,7 +69,6 @@ impl Sinusoids {
             self.scratch = vec![Complex64::default(); inv.get_inplace_scratch_len()];
             self.inverse = Some(inv);
             self.grid = vec![Complex64::default(); m];
-            self.grid2 = vec![Complex64::default(); m];
             self.len_grid = m;
         }
         let Some(inv) = self.inverse.clone() else { return };
@@ -102,30 +101,39 @@ impl Sinusoids {
         }));
         for i in (0..outputs).step_by(2) {
             let pair = i + 1 < outputs;
-            for (o, grid) in [(i, &mut self.grid), (i + 1, &mut self.grid2)] {
-                grid.iter_mut().for_each(|g| *g = Complex64::default());
-                if o >= outputs {
-                    continue;
-                }
-                for c in 0..nc {
-                    let qc = q[o * nc + c] * self.shift[c];
-                    let first = self.first[c];
-                    for l in 0..width {
-                        let at = (first + l as isize).rem_euclid(mi) as usize;
-                        grid[at] += qc * self.weights[c * width + l];
+            // G = H1 + i H2, H the Hermitian part (g_j + conj g_-j) / 2 of an output's grid: each
+            // component spread at its points and, conjugated, at their mirror images
+            self.grid.iter_mut().for_each(|g| *g = Complex64::default());
+            for c in 0..nc {
+                let q1 = q[i * nc + c] * self.shift[c];
+                let q2 = if pair {
+                    q[(i + 1) * nc + c] * self.shift[c]
+                } else {
+                    Complex64::default()
+                };
+                let (direct, mirror) = (
+                    0.5 * (q1 + Complex64::i() * q2),
+                    0.5 * (q1.conj() + Complex64::i() * q2.conj()),
+                );
+                let w = &self.weights[c * width..(c + 1) * width];
+                let start = self.first[c].rem_euclid(mi) as usize;
+                // mirror of p is m - p: of start + l, (m - start - l) mod m
+                let mstart = (m - start) % m;
+                if start + width <= m && mstart >= width - 1 {
+                    let (g, wl) = (&mut self.grid[start..start + width], w);
+                    for (gp, wp) in g.iter_mut().zip(wl) {
+                        *gp += direct * *wp;
+                    }
+                    for (l, wp) in w.iter().enumerate() {
+                        self.grid[mstart - l] += mirror * *wp;
+                    }
+                } else {
+                    for (l, wp) in w.iter().enumerate() {
+                        let p = (start + l) % m;
+                        self.grid[p] += direct * *wp;
+                        self.grid[(m - p) % m] += mirror * *wp;
                     }
                 }
-            }
-            // the Hermitian parts, the second output's times i, in `grid` (pairs j, m - j together)
-            for j in 0..=m / 2 {
-                let jm = (m - j) % m;
-                let (a, b) = (self.grid[j], self.grid[jm]);
-                let (c, d) = (self.grid2[j], self.grid2[jm]);
-                let (h1j, h1m) = (0.5 * (a + b.conj()), 0.5 * (b + a.conj()));
-                let (h2j, h2m) = (0.5 * (c + d.conj()), 0.5 * (d + c.conj()));
-                let i1 = Complex64::i();
-                self.grid[j] = h1j + i1 * h2j;
-                self.grid[jm] = h1m + i1 * h2m;
             }
             // (1/m) sum_j g_j exp(+i k' xi_j) for every k': the inverse FFT (xi_j = j h)
             inv.process_with_scratch(&mut self.grid, &mut self.scratch);

@@ -217,10 +217,15 @@ impl Stepper {
             // when they were
             Kernel::StateSpace { .. } => self.p.copy_from_slice(&self.rad_next),
         }
-        // predictor
-        for i in 0..n {
-            self.zt[n + i] = self.x[i] + dt * self.v[i] + dt * dt * (0.5 - beta) * self.a[i];
-            self.zt[i] = self.v[i] + 0.5 * dt * self.a[i];
+        // predictor (the short loops over the DOFs take slices of length n first: no bounds checks, no
+        // reloads of the vectors through `self`, and they vectorize)
+        {
+            let (vt, xt) = self.zt[..2 * n].split_at_mut(n);
+            let (x, v, a) = (&self.x[..n], &self.v[..n], &self.a[..n]);
+            for i in 0..n {
+                xt[i] = x[i] + dt * v[i] + dt * dt * (0.5 - beta) * a[i];
+                vt[i] = v[i] + 0.5 * dt * a[i];
+            }
         }
         let np = model.n_pad;
         // (B + D) vt + C xt: it does not change between the passes
@@ -241,26 +246,40 @@ impl Stepper {
                 }
                 model.nonlinear_force(&self.x_pred, &self.v_pred, &mut self.fnl, &mut self.nl);
             }
-            for i in 0..n {
-                self.rhs[i] = f1[i] - self.p[i] - self.fnl[i] - self.lin[i];
+            {
+                let (rhs, f1, p, fnl, lin) = (
+                    &mut self.rhs[..n],
+                    &f1[..n],
+                    &self.p[..n],
+                    &self.fnl[..n],
+                    &self.lin[..n],
+                );
+                for i in 0..n {
+                    rhs[i] = f1[i] - p[i] - fnl[i] - lin[i];
+                }
             }
             dense::gemv(np, &model.cols_s_inv, &self.rhs, &mut self.a_try);
             let (mut change, mut size) = (0.0f64, 0.0f64);
-            for i in 0..n {
-                let a = self.a_try[i];
-                change = change.max((a - self.a_new[i]).abs());
-                size = size.max(a.abs());
-                self.a_new[i] = a;
+            if nonlinear {
+                for (a_new, a) in self.a_new[..n].iter().zip(&self.a_try[..n]) {
+                    change = change.max((a - a_new).abs());
+                    size = size.max(a.abs());
+                }
             }
+            self.a_new[..n].copy_from_slice(&self.a_try[..n]);
             self.passes += 1;
             if !nonlinear || change <= NL_TOLERANCE * size || self.passes >= NL_MAX_PASSES {
                 break;
             }
         }
-        for i in 0..n {
-            self.x[i] = self.zt[n + i] + beta * dt * dt * self.a_new[i];
-            self.v_new[i] = self.zt[i] + 0.5 * dt * self.a_new[i];
-            self.a[i] = self.a_new[i];
+        {
+            let (vt, xt) = self.zt[..2 * n].split_at(n);
+            let (x, v_new, a_new) = (&mut self.x[..n], &mut self.v_new[..n], &self.a_new[..n]);
+            for i in 0..n {
+                x[i] = xt[i] + beta * dt * dt * a_new[i];
+                v_new[i] = vt[i] + 0.5 * dt * a_new[i];
+            }
+            self.a[..n].copy_from_slice(a_new);
         }
         // memory
         match &model.kernel {
@@ -272,6 +291,13 @@ impl Stepper {
         }
         std::mem::swap(&mut self.v, &mut self.v_new);
         self.k = k1;
+        // one pass without branches (NaN fails both comparisons); the DOF is looked for only on failure
+        let bounded = self.x[..n].iter().zip(&self.v[..n]).fold(true, |ok, (x, v)| {
+            ok & (x.abs() <= UNBOUNDED) & (v.abs() < f64::INFINITY)
+        });
+        if bounded {
+            return Ok(());
+        }
         for i in 0..n {
             let (x, v) = (self.x[i], self.v[i]);
             if !(x.is_finite() && v.is_finite()) {
