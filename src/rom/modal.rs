@@ -184,22 +184,34 @@ fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     if FMA { a.mul_add(b, c) } else { a * b + c }
 }
 
+/// beta = A^T v for the block of modes j..j + LANES, accumulated over the DOFs in registers.
+#[inline(always)]
+fn block_input<const FMA: bool>(
+    r: usize,
+    j: usize,
+    a_re: &[f64],
+    a_im: &[f64],
+    v: &[f64],
+) -> ([f64; LANES], [f64; LANES]) {
+    let (mut br, mut bi) = ([0.0f64; LANES], [0.0f64; LANES]);
+    for (i, vi) in v.iter().enumerate() {
+        let (ar, ai) = (&a_re[i * r + j..i * r + j + LANES], &a_im[i * r + j..i * r + j + LANES]);
+        for l in 0..LANES {
+            br[l] = madd::<FMA>(ar[l], *vi, br[l]);
+            bi[l] = madd::<FMA>(ai[l], *vi, bi[l]);
+        }
+    }
+    (br, bi)
+}
+
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn input_kernel(r: usize, n: usize, a_re: &[f64], a_im: &[f64], v: &[f64], re: &mut [f64], im: &mut [f64]) {
     const FMA: bool = target_cfg_f!(target_feature = "fma");
     let (re, im, v) = (&mut re[..r], &mut im[..r], &v[..n]);
-    // a block of modes at a time, accumulated over the DOFs in registers
     for j in (0..r).step_by(LANES) {
-        let (mut ar, mut ai) = ([0.0f64; LANES], [0.0f64; LANES]);
-        for (i, vi) in v.iter().enumerate() {
-            let (br, bi) = (&a_re[i * r + j..i * r + j + LANES], &a_im[i * r + j..i * r + j + LANES]);
-            for l in 0..LANES {
-                ar[l] = madd::<FMA>(br[l], *vi, ar[l]);
-                ai[l] = madd::<FMA>(bi[l], *vi, ai[l]);
-            }
-        }
-        re[j..j + LANES].copy_from_slice(&ar);
-        im[j..j + LANES].copy_from_slice(&ai);
+        let (br, bi) = block_input::<FMA>(r, j, a_re, a_im, v);
+        re[j..j + LANES].copy_from_slice(&br);
+        im[j..j + LANES].copy_from_slice(&bi);
     }
 }
 
@@ -235,7 +247,7 @@ fn absorb_kernel(r: usize, g_re: &[f64], g_im: &[f64], xr: &mut [f64], xi: &mut 
     }
 }
 
-/// beta = A^T v a block of modes at a time (as [`input_kernel`]), then x <- E x + h beta on the block
+/// beta = A^T v a block of modes at a time ([`block_input`]), then x <- E x + h beta on the block
 /// while beta is in registers.
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn advance_kernel(s: &ModalStep, v: &[f64], x: &mut [f64]) {
@@ -246,14 +258,7 @@ fn advance_kernel(s: &ModalStep, v: &[f64], x: &mut [f64]) {
     let (a_re, a_im) = (&s.a_re[..n * r], &s.a_im[..n * r]);
     let (er, ei, hr, hi) = (&s.e_re[..r], &s.e_im[..r], &s.h_re[..r], &s.h_im[..r]);
     for j in (0..r).step_by(LANES) {
-        let (mut br, mut bi) = ([0.0f64; LANES], [0.0f64; LANES]);
-        for (i, vi) in v.iter().enumerate() {
-            let (ar, ai) = (&a_re[i * r + j..i * r + j + LANES], &a_im[i * r + j..i * r + j + LANES]);
-            for l in 0..LANES {
-                br[l] = madd::<FMA>(ar[l], *vi, br[l]);
-                bi[l] = madd::<FMA>(ai[l], *vi, bi[l]);
-            }
-        }
+        let (br, bi) = block_input::<FMA>(r, j, a_re, a_im, v);
         let (xr, xi) = (&mut xr[j..j + LANES], &mut xi[j..j + LANES]);
         let (er, ei, hr, hi) = (
             &er[j..j + LANES],
