@@ -174,8 +174,8 @@ mod tests {
     use super::*;
 
     /// Gaussian gridding against the direct sum: 240 components in a band like a sea's, 3001 points,
-    /// 12 outputs (six FFTs of two) and 7 (the last one alone), positive and negative frequencies
-    /// (following seas at speed). Measured worst 5.7e-14 of the sum of |q| (tolerance 1e-10: the
+    /// 12 outputs (six FFTs of two) and 7 (the last one alone), positive, negative and near-zero
+    /// frequencies (following seas at speed). Measured worst 5.7e-14 of the sum of |q| (tolerance 1e-10: the
     /// method's own error).
     #[test]
     fn gridding_matches_the_direct_sum() {
@@ -186,12 +186,15 @@ mod tests {
             .map(|c| 0.1 * (0.25 + 1.3 * ((c * 37) % nc) as f64 / nc as f64))
             .collect();
         let xn: Vec<f64> = x.iter().map(|v| -v).collect();
+        // and frequencies near zero, both signs (encounter frequencies in following seas): their
+        // Gaussians and mirror images wrap around the grid's ends
+        let xz: Vec<f64> = (0..nc).map(|c| (c as f64 - nc as f64 / 2.0) * 1e-4).collect();
         let mut sums = Sinusoids::new();
         for outputs in [12, 7] {
             let q: Vec<Complex64> = (0..outputs * nc)
                 .map(|k| Complex64::new(((k * 13) % 17) as f64 - 8.0, ((k * 7) % 11) as f64 - 5.0))
                 .collect();
-            for x in [&x, &xn] {
+            for x in [&x, &xn, &xz] {
                 let mut fast = vec![0.0; len * outputs];
                 sums.real_sum(x, &q, outputs, len, &mut fast);
                 let mut slow = vec![0.0; len * outputs];

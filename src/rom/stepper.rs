@@ -186,8 +186,8 @@ impl Stepper {
     }
 }
 
-/// [`Stepper::step`], compiled for AVX2 + FMA as well as the baseline and chosen at run time: its
-/// short loops over the DOFs were a fifth of a state-space forecast.
+/// [`Stepper::step`], compiled for AVX2 + FMA as well as the baseline and chosen at run time (its
+/// short loops over the DOFs; the products are [`dense`]'s, the modal update [`super::modal`]'s).
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn step_dispatched(st: &mut Stepper, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
     st.step_body(model, f1, known, direct_from)
