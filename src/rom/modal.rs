@@ -8,7 +8,8 @@
 //!
 //! The stepper keeps the states one half-update ahead, with everything but the newest input
 //! (y_{k+1} = E xi_k + g0 beta_k, all the force at the new step needs before the new velocity is known),
-//! and moves them on in one pass per step ([`ModalStep::advance`]):
+//! and moves them on with one call per step ([`ModalStep::advance`]: the input and update in one pass
+//! over the modes, the force in a second):
 //! y_{k+2} = E (y_{k+1} + g1 beta_{k+1}) + g0 beta_{k+1} = E y_{k+1} + h beta_{k+1}, h = E g1 + g0.
 
 use super::dense;
@@ -146,7 +147,7 @@ impl ModalStep {
         dense::gemv(self.n_pad, &self.out_cols, &x[..2 * self.r], &mut out[..self.n]);
     }
 
-    /// The stepper's update, in one pass over the modes: from the states `x` held one half-update ahead
+    /// The stepper's update, one call per step: from the states `x` held one half-update ahead
     /// (E xi_k + g0 beta_k) and the new velocity `v`, the next such states (E x + h beta(v)), and the
     /// force they give, F = Re A x, into `out` (the first n entries).
     pub fn advance(&self, v: &[f64], x: &mut [f64], out: &mut [f64]) {
