@@ -32,8 +32,9 @@ pub fn columns(m: &DMatrix<f64>) -> Vec<f64> {
     out
 }
 
+/// a b + c, fused when the version is compiled with FMA (shared with [`super::modal`]'s kernels).
 #[inline(always)]
-fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+pub(crate) fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     if FMA { a.mul_add(b, c) } else { a * b + c }
 }
 
@@ -108,17 +109,15 @@ mod tests {
                 let x: Vec<f64> = (0..ncols).map(|j| (j as f64 * 0.7).sin()).collect();
                 let want = &m * nalgebra::DVector::from_column_slice(&x);
                 let cols = columns(&m);
-                {
-                    let mut y = vec![f64::NAN; rows];
-                    gemv(pad(rows), &cols, &x, &mut y);
-                    for i in 0..rows {
-                        assert!(
-                            (y[i] - want[i]).abs() <= 1e-12 * (1.0 + want[i].abs()),
-                            "{rows} x {ncols}, row {i}: {} vs {}",
-                            y[i],
-                            want[i]
-                        );
-                    }
+                let mut y = vec![f64::NAN; rows];
+                gemv(pad(rows), &cols, &x, &mut y);
+                for i in 0..rows {
+                    assert!(
+                        (y[i] - want[i]).abs() <= 1e-12 * (1.0 + want[i].abs()),
+                        "{rows} x {ncols}, row {i}: {} vs {}",
+                        y[i],
+                        want[i]
+                    );
                 }
             }
         }

@@ -203,7 +203,6 @@ impl Forecaster {
                 out.clear();
             }
             out.resize((steps + 1) * nm, 0.0);
-            out.truncate((steps + 1) * nm);
         }
         for (r, &i) in model.active.iter().enumerate() {
             self.out.x[i] = req.x0[r];

@@ -12,7 +12,7 @@
 //! over the modes, the force in a second):
 //! y_{k+2} = E (y_{k+1} + g1 beta_{k+1}) + g0 beta_{k+1} = E y_{k+1} + h beta_{k+1}, h = E g1 + g0.
 
-use super::dense;
+use super::dense::{self, madd};
 use crate::hydro::modal::ModalModel;
 use multiversion::multiversion;
 use multiversion::target::target_cfg_f;
@@ -179,11 +179,6 @@ impl ModalStep {
 
 /// Modes per block of the kernels: four AVX registers of f64, four independent multiply-add chains.
 pub const LANES: usize = 16;
-
-#[inline(always)]
-fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
-    if FMA { a.mul_add(b, c) } else { a * b + c }
-}
 
 /// beta = A^T v for the block of modes j..j + LANES, accumulated over the DOFs in registers.
 #[inline(always)]
