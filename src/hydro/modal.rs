@@ -427,6 +427,12 @@ fn violations(
 /// convolution's, lighter yaw in beam seas at 0.05 rad/s): 2.16 % with the share alone; w_low = 0.1 /
 /// 0.3 / 1 / 3 rad/s: 1.40 / 1.18 / 1.22 / 1.28 % (the fit uses 0.28 rad/s there; 1.25 % once w = 0 joined
 /// the check grid).
+/// Tried and dropped (session 14, pair demo): holding Re K(0) = 0 (every entry, scaled) as equality rows
+/// beside the violations, w = 0 taken off the margin (and, a second try, the margin scaled by (w / w_1)^2
+/// below the lowest database frequency w_1): 30 passes did not converge (violations kept returning
+/// between 0.03 and 0.4 rad/s while K(0) came back at 1e-6 of scale) and the floor against the
+/// convolution's went from 1.25 % to 10-12 % (lighter yaw, beam seas, 0.15 rad/s). K(0) = 0 with Re K >= 0
+/// beside it asks a PSD curvature at w = 0 the low band's tiny damping does not have.
 fn enforce_passivity(
     poles: &[Complex64],
     mut b: DMatrix<Complex64>,

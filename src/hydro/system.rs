@@ -327,7 +327,7 @@ fn finite_matrix(m: &[[f64; 6]; 6], field: &str) -> std::result::Result<Matrix6<
 
 /// Rigid-body mass matrix about the reference point from mass, centre of gravity (relative to the
 /// reference point) and radii of gyration about the centre of gravity (principal axes along x, y, z).
-/// [m I, -m [r]x; m [r]x, I_G + m (|r|^2 I - r r^T)], [r]x the cross-product matrix of r.
+/// `[m I, -m [r]x; m [r]x, I_G + m (|r|^2 I - r r^T)]`, `[r]x` the cross-product matrix of r.
 pub fn mass_matrix_from_properties(mass_kg: f64, cog_m: Vector3<f64>, radii_m: Vector3<f64>) -> Matrix6<f64> {
     let skew = cog_m.cross_matrix();
     let ig = Matrix3::from_diagonal(&radii_m.map(|r| mass_kg * r * r));

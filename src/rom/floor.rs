@@ -5,7 +5,7 @@
 //! A database whose A(w), B(w) and A_inf are not Kramers-Kronig consistent cannot be matched exactly by
 //! any causal time-domain model: the floor shows by how much, per radiation method, in RAO terms.
 //!
-//! Conventions: RAO tables are indexed [heading][frequency][state] (6N body modes then the tanks,
+//! Conventions: RAO tables are indexed `[heading][frequency][state]` (6N body modes then the tanks,
 //! inactive states zero), exp(+i w t), per metre of wave amplitude (DESIGN.md section 1).
 //!
 //! The metric (the issue's, and the integration tests'): for each (state, heading) curve, the worst

@@ -39,7 +39,7 @@ impl Default for RegularOptions {
 /// The time-domain RAO at one heading.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeRao {
-    /// rao[f][mode]: complex amplitude per metre of wave, every mode (inactive zero), exp(+i w_e t).
+    /// `rao[f][mode]`: complex amplitude per metre of wave, every mode (inactive zero), exp(+i w_e t).
     pub rao: Vec<Vec<Complex64>>,
     /// Simulated time when the steady state was accepted, s.
     pub settled_s: f64,

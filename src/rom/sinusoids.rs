@@ -1,4 +1,4 @@
-//! Sums of complex exponentials on a uniform time grid (pure): f_i[k] = sum_c q_ic exp(i x_c k) for
+//! Sums of complex exponentials on a uniform time grid (pure): `f_i[k] = sum_c q_ic exp(i x_c k)` for
 //! k = 0..len, with x_c = w_c dt in radians per step, for several outputs i sharing the frequencies.
 //!
 //! Few components: the direct sum by a complex recurrence. Many: a non-uniform FFT of type 1 by
@@ -48,7 +48,7 @@ impl Sinusoids {
         Self::default()
     }
 
-    /// out[k * outputs + i] = Re sum_c q[i * nc + c] exp(i x[c] k), k = 0..len (`q` output-major,
+    /// `out[k * outputs + i] = Re sum_c q[i * nc + c] exp(i x[c] k)`, k = 0..len (`q` output-major,
     /// `out` sized len x outputs).
     pub fn real_sum(&mut self, x: &[f64], q: &[Complex64], outputs: usize, len: usize, out: &mut [f64]) {
         let nc = x.len();

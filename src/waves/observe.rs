@@ -17,7 +17,7 @@ use num_complex::Complex64;
 use rustfft::FftPlanner;
 use std::f64::consts::PI;
 
-/// One gridded elevation snapshot: `values[iy * x_m.len() + ix]` at (x_m[ix], y_m[iy]), earth frame.
+/// One gridded elevation snapshot: `values[iy * x_m.len() + ix]` at `(x_m[ix], y_m[iy])`, earth frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
     pub x_m: Vec<f64>,
