@@ -151,12 +151,11 @@ fn one_ship_time_domain_matches_its_floor_state_space() {
     assert!(e <= TD_FLOOR_TOL, "{e} at {at}");
 }
 
-/// Two ships (the pair demo, every DOF, full coupling), heading 150 deg, state space, dt 0.025 s: the
-/// time domain against its own floor. Measured 0.24 % (lighter sway at its 1.23 rad/s coupled
-/// resonance; 0.96 % at dt 0.05, second order in dt). Against the database's frequency domain: 0.97 %
-/// at the same resonance (1.09 % when the model was refitted at each solver step; before the database
-/// was symmetrized and the damping tail fitted: 1.8 %, lighter yaw at 0.65 rad/s), not asserted: see
-/// the convolution's test below.
+/// Two ships (the pair demo, every DOF, full coupling), state space, dt 0.025 s, every mode and heading:
+/// the time domain against its own floor. Measured 0.442 % (lighter sway at its 1.23 rad/s coupled
+/// resonance, head seas; second order in dt: 1.77 % at dt 0.05; heading 150 alone 0.24 %). Against the
+/// database's frequency domain 1.80 % at the same resonance, the floor's 1.37 % plus this: not asserted,
+/// the database is not Kramers-Kronig consistent there (see the floor tests below).
 #[test]
 fn two_ship_time_domain_matches_its_floor_state_space() {
     let (e, at) = td_against(
@@ -164,7 +163,7 @@ fn two_ship_time_domain_matches_its_floor_state_space() {
         "state-space",
         "implied",
         "0.025",
-        Some("150"),
+        None,
     );
     assert!(e <= TD_FLOOR_TOL, "{e} at {at}");
 }
