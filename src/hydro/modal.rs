@@ -430,9 +430,9 @@ fn violations(
 /// Tried and dropped (session 14, pair demo): holding Re K(0) = 0 (every entry, scaled) as equality rows
 /// beside the violations, w = 0 taken off the margin (and, a second try, the margin scaled by (w / w_1)^2
 /// below the lowest database frequency w_1): 30 passes did not converge (violations kept returning
-/// between 0.03 and 0.4 rad/s while K(0) came back at 1e-6 of scale) and the floor against the
-/// convolution's went from 1.25 % to 10-12 % (lighter yaw, beam seas, 0.15 rad/s). K(0) = 0 with Re K >= 0
-/// beside it asks a PSD curvature at w = 0 the low band's tiny damping does not have.
+/// between 0.03 and 0.4 rad/s, K(0) between 1e-7 and 6e-5 of scale pass to pass) and the floor against
+/// the convolution's went from 1.25 % to 10-12 % (lighter yaw, beam seas, 0.15 rad/s). K(0) = 0 with
+/// Re K >= 0 beside it asks a PSD curvature at w = 0 the low band's tiny damping does not have.
 fn enforce_passivity(
     poles: &[Complex64],
     mut b: DMatrix<Complex64>,
