@@ -69,7 +69,7 @@ fn c_step(
             if st.k + 1 >= 1_000_000 {
                 st.k = 0;
             }
-            st.step(model, black_box(f), zeros, 1).unwrap()
+            st.step(model, black_box(f), zeros).unwrap()
         })
     });
 }

@@ -67,15 +67,10 @@ pub struct Forecaster {
     kept_we: Vec<f64>,
     kept_x: Vec<Complex64>,
     f0: Vec<f64>,
-    // FFT of the kernel (convolution with a history), built on first use
+    // FFT of the kernel (convolution with a history), built on first use; the forecast's own
+    // velocities are the stepper's ([`super::partitioned`])
     fft: Option<HistoryFft>,
-    // FFT of the kernel for the forecast's own velocities, block by block
-    block: Option<HistoryFft>,
 }
-
-/// Forecast velocities are convolved directly within a block of this many steps and by FFT beyond it
-/// (uniformly partitioned convolution: the direct sum stays short, the kernel is read once per block).
-pub const CONV_BLOCK: usize = 128;
 
 struct HistoryFft {
     len: usize,
@@ -112,8 +107,8 @@ impl HistoryFft {
         self.inverse.process_with_scratch(&mut self.acc, &mut self.scratch);
     }
 
-    /// Spectra of the first `keep` taps of the weighted kernel, zero-padded to `len`.
-    fn new(k: &[f64], taps: usize, n: usize, len: usize, keep: usize) -> HistoryFft {
+    /// Spectra of the weighted kernel's taps, zero-padded to `len`.
+    fn new(k: &[f64], taps: usize, n: usize, len: usize) -> HistoryFft {
         let mut planner = FftPlanner::new();
         let forward = planner.plan_fft_forward(len);
         let inverse = planner.plan_fft_inverse(len);
@@ -123,7 +118,7 @@ impl HistoryFft {
         for i in 0..n {
             for j in 0..n {
                 let s = &mut kernel[(i * n + j) * len..(i * n + j + 1) * len];
-                for m in 0..taps.min(keep).min(len) {
+                for m in 0..taps.min(len) {
                     s[m] = Complex64::new(k[(i * taps + m) * n + j], 0.0);
                 }
                 forward.process_with_scratch(s, &mut scratch);
@@ -162,7 +157,6 @@ impl Forecaster {
             kept_x: vec![],
             f0: vec![],
             fft: None,
-            block: None,
         }
     }
 
@@ -209,20 +203,14 @@ impl Forecaster {
             self.out.v[i] = req.v0[r];
             self.out.a[i] = self.stepper.a[r];
         }
-        let blocked = matches!(model.kernel, Kernel::Convolution { .. }) && steps > 2 * CONV_BLOCK;
-        let mut direct_from = 1;
         for k in 1..=steps {
             let f = &self.force[k * n..(k + 1) * n];
             let kn = self.known.get(k * n..(k + 1) * n).unwrap_or(&[]);
-            self.stepper.step(model, f, kn, direct_from)?;
+            self.stepper.step(model, f, kn)?;
             for (r, &i) in model.active.iter().enumerate() {
                 self.out.x[k * nm + i] = self.stepper.x[r];
                 self.out.v[k * nm + i] = self.stepper.v[r];
                 self.out.a[k * nm + i] = self.stepper.a[r];
-            }
-            if blocked && k % CONV_BLOCK == 0 && k < steps {
-                self.block_part(model, k + 1 - CONV_BLOCK, steps)?;
-                direct_from = k + 1;
             }
         }
         Ok(&self.out)
@@ -247,45 +235,6 @@ impl Forecaster {
             ramp_s,
         };
         self.forecast(model, &req)
-    }
-
-    /// Adds to `known` the convolution of the forecast velocities j0..j0+B-1 with the kernel, for every
-    /// later output up to `steps`, by FFT.
-    fn block_part(&mut self, model: &TimeModel, j0: usize, steps: usize) -> Result<()> {
-        let Kernel::Convolution { taps, k } = &model.kernel else {
-            return Ok(());
-        };
-        let (taps, n, b) = (*taps, model.n(), CONV_BLOCK);
-        let len = (steps + b).next_power_of_two();
-        if self
-            .block
-            .as_ref()
-            .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
-        {
-            self.block = Some(HistoryFft::new(k, taps, n, len, len - b));
-        }
-        let Some(f) = self.block.as_mut() else { return Ok(()) };
-        let nm = model.n_modes;
-        f.u.iter_mut().for_each(|c| *c = Complex64::default());
-        for p in 0..b {
-            for (j, &mode) in model.active.iter().enumerate() {
-                f.u[j * len + p] = Complex64::new(self.out.v[(j0 + p) * nm + mode], 0.0);
-            }
-        }
-        f.transform_inputs(n);
-        let scale = 1.0 / len as f64;
-        for i in 0..n {
-            f.output(i, n);
-            // output index j0 + q for q >= B (after the block)
-            for q in b..len {
-                let out = j0 + q;
-                if out > steps {
-                    break;
-                }
-                self.known[out * n + i] += f.acc[q].re * scale;
-            }
-        }
-        Ok(())
     }
 
     /// The wave force a request implies at t0 + k dt, k = 0..steps (k-major, active DOFs), through the
@@ -370,7 +319,7 @@ impl Forecaster {
     /// The radiation force from the velocities up to t0 (history and v0) at every step, by FFT:
     /// P[k] = sum_{m >= k} K~_m v_{k-m}.
     fn history_part(&mut self, model: &TimeModel, v0: &[f64], memory: &Memory, steps: usize) -> Result<()> {
-        let Kernel::Convolution { taps, k } = &model.kernel else {
+        let Kernel::Convolution { taps, k, .. } = &model.kernel else {
             return Ok(());
         };
         let (taps, n) = (*taps, model.n());
@@ -380,7 +329,7 @@ impl Forecaster {
             .as_ref()
             .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
         {
-            self.fft = Some(HistoryFft::new(k, taps, n, len, taps));
+            self.fft = Some(HistoryFft::new(k, taps, n, len));
         }
         let Some(f) = self.fft.as_mut() else { return Ok(()) };
         // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0

@@ -22,7 +22,7 @@
 //! lines and fenders are nonlinear forces relative to their equilibrium value.
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
-//! reference) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced truncation,
+//! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs, [`partitioned`]) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced truncation,
 //! passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
@@ -34,6 +34,7 @@ pub mod memory;
 pub mod modal;
 pub mod model;
 pub mod outputs;
+pub mod partitioned;
 pub mod regular;
 pub mod sinusoids;
 pub mod stepper;

@@ -1,6 +1,7 @@
 //! The assembled time-domain model of a vessel system over its active DOFs (pure).
 
 use super::modal::ModalStep;
+use super::partitioned::{Partitions, block_for};
 use super::{Error, Result};
 use crate::hydro::check::{
     RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
@@ -56,8 +57,13 @@ impl Default for RomOptions {
 /// The radiation memory of a model, ready for stepping.
 #[derive(Debug, Clone)]
 pub enum Kernel {
-    /// `k[(i * taps + m) * n + j] = dt w_m K_m(i, j)`, trapezoid weights w_0 = w_last = 1/2.
-    Convolution { taps: usize, k: Vec<f64> },
+    /// `k[(i * taps + m) * n + j] = dt w_m K_m(i, j)`, trapezoid weights w_0 = w_last = 1/2; `parts`: the
+    /// taps from one block on in the frequency domain, for a run's own velocities ([`super::partitioned`]).
+    Convolution {
+        taps: usize,
+        k: Vec<f64>,
+        parts: std::sync::Arc<Partitions>,
+    },
     /// The fitted modal model and its exact discrete update at the solver's step.
     StateSpace {
         model: Box<ModalModel>,
@@ -175,6 +181,7 @@ impl TimeModel {
                     Kernel::Convolution {
                         taps: 1,
                         k: vec![0.0; n * n],
+                        parts: std::sync::Arc::new(Partitions::new(&[], 1, n, block_for(1))),
                     },
                     DMatrix::zeros(n, n),
                 )
@@ -191,7 +198,8 @@ impl TimeModel {
                     }
                 }
                 let d = DMatrix::from_fn(n, n, |i, j| k[(i * taps) * n + j]);
-                (Kernel::Convolution { taps, k }, d)
+                let parts = std::sync::Arc::new(Partitions::new(&k, taps, n, block_for(taps)));
+                (Kernel::Convolution { taps, k, parts }, d)
             }
             RadiationMethod::StateSpace => {
                 let model = active_radiation(sys, &a_inf_all, &tail)

@@ -181,13 +181,13 @@ fn run_until(
     let mut k = 0;
     while k < ramp_steps.min(limit) {
         k += 1;
-        st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
+        st.step(model, &force[k * n..(k + 1) * n], &zeros)?;
     }
     while k + wsteps <= limit {
         let start = k + 1;
         for r in 0..wsteps {
             k += 1;
-            st.step(model, &force[k * n..(k + 1) * n], &zeros, 1)?;
+            st.step(model, &force[k * n..(k + 1) * n], &zeros)?;
             record[r * n..(r + 1) * n].copy_from_slice(&st.x);
         }
         let fit = fit_window(&record, n, we, start as f64 * dt, dt, wsteps);

@@ -5,6 +5,7 @@
 use super::dense;
 use super::memory::Memory;
 use super::model::{Kernel, NlScratch, TimeModel};
+use super::partitioned::PartitionedRun;
 use super::{Error, Result};
 use multiversion::multiversion;
 
@@ -24,6 +25,8 @@ pub struct Stepper {
     pub k: usize,
     /// Convolution: velocities in reverse time order; v_k at (capacity - k) n, history after v_0.
     buf: Vec<f64>,
+    /// Convolution: the run's velocities (v_1 on) against the taps beyond one block.
+    run: PartitionedRun,
     /// State space: the modes' states (r real parts, then r imaginary parts), held one half-update
     /// ahead during a run (see [`super::modal`]), and their input b . v at the start, laid out alike.
     states: Vec<f64>,
@@ -130,7 +133,11 @@ impl Stepper {
         let mut frad = std::mem::take(&mut self.p);
         frad.iter_mut().for_each(|f| *f = 0.0);
         match (&model.kernel, memory) {
-            (Kernel::Convolution { taps, k }, Memory::Convolution { .. }) => {
+            (Kernel::Convolution { taps, k, parts }, Memory::Convolution { .. }) => {
+                // the run's input s_0 is zero: v_0 and the history are the caller's known part
+                self.run.reset(parts);
+                self.v_new.iter_mut().for_each(|v| *v = 0.0);
+                self.run.push(parts, &self.v_new);
                 let p0 = self.pos(0);
                 self.buf[p0..p0 + n].copy_from_slice(v0);
                 for m in 1..*taps {
@@ -178,24 +185,23 @@ impl Stepper {
     }
 
     /// Advances one step with the wave force `f1` at the new time and the known radiation part `known`:
-    /// the convolution over the history before t0 and over the forecast's own velocities with index
-    /// below `direct_from` (the caller's block FFTs); the velocities from `direct_from` on are convolved
-    /// here directly. `direct_from = 1` convolves all forecast velocities here.
-    pub fn step(&mut self, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
-        step_dispatched(self, model, f1, known, direct_from)
+    /// the convolution over the start's velocity and the history before it (empty: none). The run's own
+    /// velocities are convolved here: the last block's taps directly, the rest by partitioned FFTs.
+    pub fn step(&mut self, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
+        step_dispatched(self, model, f1, known)
     }
 }
 
 /// [`Stepper::step`], compiled for AVX2 + FMA as well as the baseline and chosen at run time (its
 /// short loops over the DOFs; the products are [`dense`]'s, the modal update [`super::modal`]'s).
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
-fn step_dispatched(st: &mut Stepper, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
-    st.step_body(model, f1, known, direct_from)
+fn step_dispatched(st: &mut Stepper, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
+    st.step_body(model, f1, known)
 }
 
 impl Stepper {
     #[inline(always)]
-    fn step_body(&mut self, model: &TimeModel, f1: &[f64], known: &[f64], direct_from: usize) -> Result<()> {
+    fn step_body(&mut self, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
         let n = self.n;
         let dt = model.opts.dt_s;
         let beta = model.opts.beta;
@@ -205,12 +211,15 @@ impl Stepper {
         }
         // radiation: known part P
         match &model.kernel {
-            Kernel::Convolution { taps, k } => {
-                let mcount = k1.saturating_sub(direct_from.max(1)).min(taps - 1);
+            Kernel::Convolution { taps, k, parts } => {
+                // taps 1..B-1 over v_k1-1 back to v_1 directly; the partitions have the rest
+                let mcount = (k1 - 1).min(parts.block - 1).min(taps - 1);
                 let start = self.pos(k1 as isize - 1);
+                let tail = self.run.tail(parts, k1);
                 for i in 0..n {
                     let row = &k[(i * taps + 1) * n..(i * taps + 1 + mcount) * n];
-                    self.p[i] = known[i] + dot(row, &self.buf[start..start + mcount * n]);
+                    let known_i = known.get(i).copied().unwrap_or(0.0);
+                    self.p[i] = known_i + tail[i] + dot(row, &self.buf[start..start + mcount * n]);
                 }
             }
             // the states hold everything but the new input (E xi + g0 beta_k): their force, computed
@@ -283,9 +292,10 @@ impl Stepper {
         }
         // memory
         match &model.kernel {
-            Kernel::Convolution { .. } => {
+            Kernel::Convolution { parts, .. } => {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
+                self.run.push(parts, &self.v_new);
             }
             Kernel::StateSpace { step, .. } => step.advance(&self.v_new, &mut self.states, &mut self.rad_next),
         }
