@@ -70,7 +70,8 @@ fn c_step(
             // back to the prepared state now and then: the modes without restoring drift, and a long
             // enough run (4e4 s: 4e5 steps) leaves the bound on displacements
             if st.k + 1 >= 100_000 {
-                st.start(model, &prep.x0, &prep.v0, &prep.memory, 1_000_000, zeros).unwrap();
+                st.start(model, &prep.x0, &prep.v0, &prep.memory, 1_000_000, zeros)
+                    .unwrap();
             }
             st.step(model, black_box(f), zeros).unwrap()
         })
