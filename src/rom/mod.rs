@@ -22,8 +22,9 @@
 //! lines and fenders are nonlinear forces relative to their equilibrium value.
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
-//! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs, [`partitioned`]) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced truncation,
-//! passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
+//! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs,
+//! [`partitioned`]) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced
+//! truncation, passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
 
