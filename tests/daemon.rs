@@ -394,18 +394,33 @@ fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
     assert!(before >= 3 && after >= 3);
 }
 
+/// Regression (issue 29): with no daemon, the subscriber died with a Python traceback
+/// (`PublishSubscribeOpenError: DoesNotExist`).
+#[test]
+fn the_python_subscriber_says_in_a_line_when_no_daemon_runs() {
+    let out = Command::new(crate::util::python())
+        .args([
+            repo("tools/console/subscriber.py").to_str().unwrap(),
+            "--prefix",
+            &format!("shipcast-test-{}-nodaemon", std::process::id()),
+            "--timeout",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("no shipcast daemon publishes") && !err.contains("Traceback"), "{err}");
+}
+
 #[test]
 fn a_python_console_decodes_a_live_forecast() {
-    let have = Command::new("python3").args(["-c", "import iceoryx2"]).status();
-    assert!(
-        have.is_ok_and(|s| s.success()),
-        "python3 with the iceoryx2 package is needed: python3 -m pip install -r tools/console/requirements.txt"
-    );
+    let python = crate::util::python();
     let dir = crate::util::scratch_dir("daemon-python");
     let cfg = config(&dir, "python", "");
     let _daemon = daemon(&cfg);
     let _sim = simulator(&cfg, "100", &[]);
-    let out = Command::new("python3")
+    let out = Command::new(&python)
         .args([
             repo("tools/console/subscriber.py").to_str().unwrap(),
             "--prefix",

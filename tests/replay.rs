@@ -129,16 +129,10 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
 
 #[test]
 fn python_lists_the_channels_and_decodes_a_message_of_each() {
-    let have = std::process::Command::new("python3")
-        .args(["-c", "import mcap"])
-        .status();
-    assert!(
-        have.is_ok_and(|s| s.success()),
-        "python3 with the mcap package is needed: python3 -m pip install -r tools/replay/requirements.txt"
-    );
+    let python = crate::util::python();
     let dir = scratch_dir("replay-python");
     let (_, log) = simulated_log(&dir, 30);
-    let out = std::process::Command::new("python3")
+    let out = std::process::Command::new(&python)
         .args([
             repo("tools/replay/list_log.py").to_str().unwrap(),
             log.to_str().unwrap(),

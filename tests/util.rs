@@ -127,3 +127,52 @@ pub fn write_flat_database(dir: &Path, a: [f64; 6], b: [f64; 6], c: [f64; 6], ro
     }
     std::fs::write(dir.join("flat.hst"), hst).unwrap();
 }
+
+/// The Python interpreter of the tests' own virtual environment, with the pinned packages of
+/// `tools/console/requirements.txt` and `tools/replay/requirements.txt` (iceoryx2, mcap). Made once,
+/// under `target/tmp/py-venv`, with `python3 -m venv` and the venv's own pip (never the system's), and
+/// made again when a requirements file changes. A file lock keeps two test processes from building it
+/// at once. Panics with what is missing (python3, its venv module, PyPI) rather than skipping a test.
+pub fn python() -> PathBuf {
+    static PYTHON: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    PYTHON.get_or_init(make_venv).clone()
+}
+
+fn make_venv() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("py-venv");
+    let reqs = [repo("tools/console/requirements.txt"), repo("tools/replay/requirements.txt")];
+    let mut want = String::new();
+    for r in &reqs {
+        want.push_str(&std::fs::read_to_string(r).expect("requirements file"));
+    }
+    std::fs::create_dir_all(dir.parent().unwrap()).unwrap();
+    let lock = std::fs::File::create(dir.with_extension("lock")).expect("venv lock file");
+    lock.lock().expect("lock the venv");
+    let stamp = dir.join("shipcast-requirements.txt");
+    let python = dir.join("bin").join("python");
+    if std::fs::read_to_string(&stamp).ok().as_deref() == Some(want.as_str()) && python.exists() {
+        return python;
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let run = |cmd: &mut Command, what: &str| {
+        let out = cmd.output().unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert!(
+            out.status.success(),
+            "{what} failed:\n{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run(
+        Command::new("python3").args(["-m", "venv"]).arg(&dir),
+        "python3 -m venv (Python 3 with its venv module is a prerequisite: README)",
+    );
+    let mut pip = Command::new(&python);
+    pip.args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"]);
+    for r in &reqs {
+        pip.arg("-r").arg(r);
+    }
+    run(&mut pip, "pip install of the tests' Python packages into target/tmp/py-venv");
+    std::fs::write(&stamp, want).unwrap();
+    python
+}

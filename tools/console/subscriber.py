@@ -9,12 +9,15 @@ surge, sway, heave, roll, pitch, yaw), steps + 1 displacements each at issue_tim
     python3 tools/console/subscriber.py --prefix shipcast --count 3
 
 Prints one JSON object per forecast: issue time, dt, horizon per vessel, flags, and the heave of each
-vessel at 0, 30 and 60 s ahead. Exits non-zero if nothing arrives within --timeout seconds.
+vessel at 0, 30 and 60 s ahead (a non-finite number is written as null). Waits up to --timeout seconds
+for the daemon's service to appear and for the forecasts; exits 1 with a one-line message if they do not,
+and skips (with a line on stderr) a payload whose header does not fit its data.
 """
 
 import argparse
 import ctypes
 import json
+import math
 import sys
 import time
 
@@ -52,6 +55,12 @@ class ForecastHeader(ctypes.Structure):
 def decode(header, payload) -> dict:
     if header.schema_version != SCHEMA_VERSION:
         raise ValueError(f"schema version {header.schema_version}: this script reads {SCHEMA_VERSION}")
+    if header.n_vessels > MAX_VESSELS:
+        raise ValueError(f"n_vessels {header.n_vessels} > {MAX_VESSELS}")
+    if header.n_series < 6 * header.n_vessels:
+        raise ValueError(f"n_series {header.n_series} < 6 x n_vessels {header.n_vessels}")
+    if not (math.isfinite(header.dt_s) and header.dt_s > 0.0):
+        raise ValueError(f"dt_s {header.dt_s}")
     n = header.steps + 1
     expected = header.n_series * n
     count = payload.len()
@@ -67,7 +76,7 @@ def decode(header, payload) -> dict:
             k = int(round(lead / header.dt_s))
             if k < n:
                 at[f"{lead:.0f}"] = heave[k]
-        vessels.append({"horizon_s": header.horizon_s[v], "heave_at_lead_s": at})
+        vessels.append({"horizon_s": finite_or_none(header.horizon_s[v]), "heave_at_lead_s": at})
     return {
         "issue_time_s": header.issue_time_s,
         "dt_s": header.dt_s,
@@ -78,23 +87,48 @@ def decode(header, payload) -> dict:
     }
 
 
+def open_forecasts(node, prefix: str, timeout_s: float):
+    """The daemon's forecast service, waited for up to timeout_s; None if it never appears."""
+    t0 = time.monotonic()
+    while True:
+        try:
+            return (
+                node.service_builder(iox2.ServiceName.new(f"{prefix}/forecast"))
+                .publish_subscribe(iox2.Slice[ctypes.c_double])
+                .user_header(ForecastHeader)
+                .open()
+            )
+        except iox2.PublishSubscribeOpenError as e:
+            if "DoesNotExist" not in str(e) or time.monotonic() - t0 > timeout_s:
+                if "DoesNotExist" not in str(e):
+                    print(f"cannot open {prefix}/forecast: {e}", file=sys.stderr)
+                return None
+            time.sleep(0.2)
+
+
+def finite_or_none(x: float):
+    return x if math.isfinite(x) else None
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--prefix", default="shipcast")
     ap.add_argument("--count", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=30.0)
     a = ap.parse_args()
-    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
     node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
-    service = (
-        node.service_builder(iox2.ServiceName.new(f"{a.prefix}/forecast"))
-        .publish_subscribe(iox2.Slice[ctypes.c_double])
-        .user_header(ForecastHeader)
-        .open()
-    )
+    t0 = time.monotonic()
+    service = open_forecasts(node, a.prefix, a.timeout)
+    if service is None:
+        print(
+            f"no shipcast daemon publishes {a.prefix}/forecast (waited {a.timeout:g} s): start `shipcast run`, "
+            "or give its [ipc] service_prefix with --prefix",
+            file=sys.stderr,
+        )
+        return 1
     subscriber = service.subscriber_builder().create()
     seen = 0
-    t0 = time.monotonic()
     while seen < a.count:
         if time.monotonic() - t0 > a.timeout:
             print(f"no forecast within {a.timeout} s", file=sys.stderr)
@@ -103,7 +137,12 @@ def main() -> int:
         if sample is None:
             time.sleep(0.05)
             continue
-        print(json.dumps(decode(sample.user_header().contents, sample.payload())), flush=True)
+        try:
+            decoded = decode(sample.user_header().contents, sample.payload())
+        except ValueError as e:
+            print(f"forecast refused: {e}", file=sys.stderr)
+            continue
+        print(json.dumps(decoded, allow_nan=False), flush=True)
         seen += 1
     return 0
 
