@@ -11,16 +11,17 @@ use std::path::{Path, PathBuf};
 /// Errors of the file layer: the file that could not be opened, or what the reader found in it.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    /// The OS error is part of the message, not a source: printed once.
+    #[error("{}: {err}", path.display())]
+    Io { path: PathBuf, err: std::io::Error },
     #[error(transparent)]
     Hydro(#[from] hydro::Error),
 }
 
 fn open(path: &Path) -> Result<BufReader<File>, Error> {
-    File::open(path).map(BufReader::new).map_err(|source| Error::Io {
+    File::open(path).map(BufReader::new).map_err(|err| Error::Io {
         path: path.to_path_buf(),
-        source,
+        err,
     })
 }
 
@@ -37,9 +38,9 @@ pub struct Loaded {
 /// Loads `system.toml` and the WAMIT files it names (`.1`, `.3` or else `.2`, `.hst`; `.3fk` and
 /// `.3sc` when present are read and checked against the total excitation).
 pub fn load_system(path: &Path) -> Result<Loaded, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|err| Error::Io {
         path: path.to_path_buf(),
-        source,
+        err,
     })?;
     let spec = SystemSpec::from_toml(&text, &path.display().to_string())?;
     let dir = path.parent().unwrap_or(Path::new("."));
@@ -92,8 +93,8 @@ pub fn load_system(path: &Path) -> Result<Loaded, Error> {
 
 /// Reads a CSV or text file whole (for the CLI's own inputs).
 pub fn read_text(path: &Path) -> Result<String, Error> {
-    std::fs::read_to_string(path).map_err(|source| Error::Io {
+    std::fs::read_to_string(path).map_err(|err| Error::Io {
         path: path.to_path_buf(),
-        source,
+        err,
     })
 }

@@ -71,11 +71,11 @@ enum Command {
 struct ForecastArgs {
     /// The scenario file (e.g. config/scenarios/two-ship.toml).
     scenario: PathBuf,
-    /// Forecast horizon, s (default: the scenario's).
-    #[arg(long)]
+    /// Forecast length, s, in (0, 3600] (default: the scenario's).
+    #[arg(long, allow_negative_numbers = true, value_parser = forecast_length)]
     horizon: Option<f64>,
     /// Run the forecast N times and print the median and p95 wall time of one, as the last line.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1)]
     repeat: usize,
     /// Radiation memory (default: the scenario's).
     #[arg(long, value_enum)]
@@ -86,6 +86,16 @@ struct ForecastArgs {
     /// Write the forecast here instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
+}
+
+/// `--horizon`: checked as it is read, before any work.
+fn forecast_length(s: &str) -> Result<f64, String> {
+    let max = shipcast::rom::forecast::MAX_FORECAST_LENGTH_S;
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= max => Ok(v),
+        Ok(v) => Err(format!("{v} s: a forecast's length must be in (0, {max}] s")),
+        Err(_) => Err(format!("`{s}` is not a number of seconds")),
+    }
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -132,13 +142,13 @@ struct RaoArgs {
     #[arg(long)]
     omega: Option<String>,
     /// Forward speed, m/s.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     speed: f64,
     /// Radiation memory of the time-domain model.
     #[arg(long, value_enum, default_value = "convolution")]
     radiation: Radiation,
     /// Time step of the time-domain model, s.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.1)]
     dt: f64,
 }
 
@@ -654,7 +664,8 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
         times_ms.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let f = fc.forecast(&model, &req)?;
-    let labels: Vec<String> = (0..sys.n_states()).map(|i| mode_label(sys, i)).collect();
+    let labels: Vec<String> = (0..sys.n_states()).map(|i| check::output_label(sys, i)).collect();
+    let value = |k: usize, i: usize| check::output_value(sys, i, f.at(k, i));
     let extra = shipcast::rom::outputs::derived(&sys.spec.external, f);
     let horizons = scenario_horizons(sys, &sc, &prep.waves);
     let mut text = String::new();
@@ -669,7 +680,7 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
             for k in 0..=f.steps {
                 text.push_str(&format!("{:.3}", k as f64 * f.dt_s));
                 for i in 0..f.n_modes {
-                    text.push_str(&format!(",{:.6e}", f.at(k, i)));
+                    text.push_str(&format!(",{:.6e}", value(k, i)));
                 }
                 for c in 0..extra.names.len() {
                     text.push_str(&format!(",{:.6e}", extra.at(k, c)));
@@ -687,7 +698,7 @@ fn forecast(args: &ForecastArgs) -> Result<()> {
                     .collect::<Vec<_>>()
                     .join(",")
             };
-            let motion = series(f.n_modes, &|i| labels[i].clone(), &|k, i| f.at(k, i));
+            let motion = series(f.n_modes, &|i| labels[i].clone(), &value);
             let derived = series(extra.names.len(), &|c| extra.names[c].clone(), &|k, c| extra.at(k, c));
             text.push_str(&format!(
                 "{{\"dt_s\":{},\"horizon_s\":{},\"predictable_horizon_s\":{{{}}},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{motion}}},\"points\":{{{derived}}}}}\n",

@@ -130,6 +130,16 @@ impl Scenario {
                 return Err(bad(k, format!("must be positive, found {v}")));
             }
         }
+        if raw.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
+            return Err(bad(
+                "horizon_s",
+                format!(
+                    "at most {} s, found {}",
+                    crate::rom::forecast::MAX_FORECAST_LENGTH_S,
+                    raw.horizon_s
+                ),
+            ));
+        }
         if let Some(r) = raw.radar_radius_m
             && !(r.is_finite() && r > 0.0)
         {

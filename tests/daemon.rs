@@ -177,7 +177,7 @@ fn forecasts_over_iceoryx2_match_the_simulated_truth() {
         let dt = f["dt_s"].as_f64().unwrap();
         let k = (LEAD_S / dt).round() as usize;
         let v = &f["vessels"][0]["dofs"];
-        let (Some(h), Some(p)) = (v["heave"][k].as_f64(), v["pitch"][k].as_f64()) else {
+        let (Some(h), Some(p)) = (v["heave_m"][k].as_f64(), v["pitch_deg"][k].as_f64()) else {
             continue;
         };
         let (Some(h_true), Some(p_true)) = (at(&t, &rows, t0 + LEAD_S, 2), at(&t, &rows, t0 + LEAD_S, 4)) else {
@@ -410,7 +410,10 @@ fn the_python_subscriber_says_in_a_line_when_no_daemon_runs() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("no shipcast daemon publishes") && !err.contains("Traceback"), "{err}");
+    assert!(
+        err.contains("no shipcast daemon publishes") && !err.contains("Traceback"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -11,7 +11,7 @@ fn csv_forecast_and_timing_line() {
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(
         lines[0],
-        "t_s,carrier.surge,carrier.sway,carrier.heave,carrier.roll,carrier.pitch,carrier.yaw"
+        "t_s,carrier.surge_m,carrier.sway_m,carrier.heave_m,carrier.roll_deg,carrier.pitch_deg,carrier.yaw_deg"
     );
     // 60 s at 0.1 s: 601 rows, then the timing line
     assert_eq!(lines.len(), 1 + 601 + 1, "{}", lines.len());
@@ -49,7 +49,7 @@ fn json_forecast_to_a_file() {
     let text = std::fs::read_to_string(&out_path).unwrap();
     let _ = std::fs::remove_file(&out_path);
     assert!(
-        text.starts_with("{\"dt_s\":0.1,\"horizon_s\":60,") && text.contains("\"carrier.heave\":["),
+        text.starts_with("{\"dt_s\":0.1,\"horizon_s\":60,") && text.contains("\"carrier.heave_m\":["),
         "{}",
         &text[..120.min(text.len())]
     );
@@ -80,7 +80,7 @@ fn moored_forecast_has_points_relative_motions_and_connection_forces() {
     let mut lines = out.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     for want in [
-        "lighter.roll",
+        "lighter.roll_deg",
         "crane_tip.z",
         "crane_tip.vz",
         "crane_tip.az",

@@ -6,6 +6,7 @@ mod util;
 
 mod bad_input;
 mod capytaine_demo;
+mod cli;
 mod console;
 mod core_purity;
 mod daemon;

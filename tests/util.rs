@@ -140,7 +140,10 @@ pub fn python() -> PathBuf {
 
 fn make_venv() -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("py-venv");
-    let reqs = [repo("tools/console/requirements.txt"), repo("tools/replay/requirements.txt")];
+    let reqs = [
+        repo("tools/console/requirements.txt"),
+        repo("tools/replay/requirements.txt"),
+    ];
     let mut want = String::new();
     for r in &reqs {
         want.push_str(&std::fs::read_to_string(r).expect("requirements file"));
@@ -172,7 +175,10 @@ fn make_venv() -> PathBuf {
     for r in &reqs {
         pip.arg("-r").arg(r);
     }
-    run(&mut pip, "pip install of the tests' Python packages into target/tmp/py-venv");
+    run(
+        &mut pip,
+        "pip install of the tests' Python packages into target/tmp/py-venv",
+    );
     std::fs::write(&stamp, want).unwrap();
     python
 }

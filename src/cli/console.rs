@@ -6,10 +6,8 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use shipcast::console::{Action, Console, Forecast, Health, Key, Settings};
-use shipcast::files;
 use shipcast::ipc::wire::{SCHEMA_VERSION, flags};
 use shipcast::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
@@ -17,14 +15,14 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 #[derive(Args, Debug)]
 pub struct ConsoleArgs {
-    #[arg(long, default_value = super::daemon::DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Service prefix to subscribe under (default: the config's `ipc.service_prefix`; a replay
     /// publishes under `<prefix>-replay`).
     #[arg(long)]
     prefix: Option<String>,
     /// Quit after this many seconds (scripted captures; default: until q).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
 }
 
@@ -115,15 +113,15 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
 pub fn run(a: &ConsoleArgs) -> Result<()> {
     use ratatui::crossterm::event::{self, KeyCode, KeyEventKind, KeyModifiers};
     let cfg = super::daemon::load_config(&a.config)?;
-    let sys = files::load_system(&super::daemon::system_path(&cfg))?.system;
+    let sys = super::daemon::load_system(&cfg)?;
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
     let ext = sys.spec.external.clone();
-    let channels = cfg.operation_channels(&vessels, &ext, &a.config)?;
+    let channels = cfg.operation_channels(&vessels, &ext, &cfg.path)?;
     let colours = cfg
         .console
         .colours
         .parse()
-        .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", a.config.display()))?;
+        .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", cfg.path.display()))?;
     let settings = Settings {
         channels,
         duration_s: cfg.operation.duration_s,

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::files;
+use shipcast::hydro::Dof;
 use shipcast::ipc::wire::{Status, flags};
 use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
 use shipcast::service::config::{self, ShipcastConfig};
@@ -11,24 +12,21 @@ use shipcast::sim::{ImuSpec, RadarSpec, SimSpec, Simulation};
 use shipcast::waves::field::heading_from_compass_deg;
 use shipcast::waves::sea::{SeaState, Spreading};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-pub const DEFAULT_CONFIG: &str = "config/shipcast.toml";
-
 #[derive(Args, Debug)]
 pub struct RunArgs {
-    /// Configuration file.
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    pub config: PathBuf,
+    #[command(flatten)]
+    pub config: super::ConfigArg,
 }
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Publish the sensor streams live over iceoryx2 (paced by the data clock / simulate.speed).
     #[arg(long)]
     publish: bool,
@@ -39,35 +37,50 @@ pub struct SimulateArgs {
     #[arg(long, conflicts_with = "publish")]
     record: Option<PathBuf>,
     /// Simulated duration, s (default: simulate.duration_s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
 }
 
 #[derive(Args, Debug)]
 pub struct WatchArgs {
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Stop after N forecasts.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     count: Option<usize>,
     /// One JSON object a line.
     #[arg(long)]
     json: bool,
     /// Give up after this many seconds without a forecast (default: wait for ever).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     timeout: Option<f64>,
 }
 
-pub fn load_config(path: &Path) -> Result<ShipcastConfig> {
-    Ok(config::load(path)?)
+pub fn load_config(arg: &super::ConfigArg) -> Result<ShipcastConfig> {
+    let path = arg.path();
+    if !path.exists() {
+        bail!(
+            "{}: no such configuration file (give --config FILE or set SHIPCAST_CONFIG; without them shipcast looks for {})",
+            path.display(),
+            super::CONFIG_SEARCH.join(" and ")
+        );
+    }
+    Ok(config::load(&path)?)
 }
 
 pub fn system_path(cfg: &ShipcastConfig) -> PathBuf {
     cfg.dir.join(&cfg.system.file)
 }
 
+/// The config's vessel system; an error names the config file and its `[system] file` key.
+pub fn load_system(cfg: &ShipcastConfig) -> Result<shipcast::hydro::VesselSystem> {
+    files::load_system(&system_path(cfg))
+        .map(|l| l.system)
+        .with_context(|| format!("{}: [system] file = {:?}", cfg.path.display(), cfg.system.file))
+}
+
 pub fn run(cfg: ShipcastConfig) -> Result<()> {
-    let sys = files::load_system(&system_path(&cfg))?.system;
+    let sys = load_system(&cfg)?;
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
@@ -121,7 +134,7 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
 
 pub fn simulate(a: &SimulateArgs) -> Result<()> {
     let cfg = load_config(&a.config)?;
-    let sys = files::load_system(&system_path(&cfg))?.system;
+    let sys = load_system(&cfg)?;
     let duration = a.duration.unwrap_or(cfg.simulate.duration_s);
     if !(duration.is_finite() && duration > 0.0) {
         bail!("--duration {duration}: must be positive");
@@ -135,7 +148,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         .spec
         .bodies
         .iter()
-        .flat_map(|b| ["surge", "sway", "heave", "roll", "pitch", "yaw"].map(|d| format!("{}.{d}", b.name)))
+        .flat_map(|b| Dof::ALL.map(|d| format!("{}.{}", b.name, d.output_name())))
         .collect();
     let publisher = if a.publish {
         Some(
@@ -243,7 +256,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         if let Some(f) = truth_out.as_mut() {
             write!(f, "{:.3}", t + if publisher.is_some() { epoch } else { 0.0 })?;
             for i in 0..6 * n_bodies {
-                write!(f, ",{:.6e}", sim.true_x(t, i))?;
+                write!(f, ",{:.6e}", Dof::of_index(i).to_output(sim.true_x(t, i)))?;
             }
             writeln!(f)?;
         }
@@ -283,114 +296,106 @@ fn ctrlc_flag(flag: Arc<AtomicBool>) -> std::io::Result<()> {
     Ok(())
 }
 
-const DOF: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+/// A finite number, or JSON null: no `inf` or `NaN` reaches a JSON line.
+fn finite(v: f64) -> serde_json::Value {
+    if v.is_finite() {
+        serde_json::json!(v)
+    } else {
+        serde_json::Value::Null
+    }
+}
 
-/// A forecast as one JSON line (the format `watch --json` documents).
+/// A forecast as one JSON line (the format `watch --json` documents): per vessel its DOFs in output
+/// units (`heave_m`, `roll_deg`, ...) and the displacement of its points of interest (`x_m`, `y_m`,
+/// `z_m`, global axes); non-finite numbers as null.
 pub fn forecast_json(
     h: &shipcast::ipc::wire::ForecastHeader,
     values: &[f64],
     sys: &shipcast::hydro::VesselSystem,
 ) -> String {
+    use serde_json::{Map, Value, json};
     let n = h.steps as usize + 1;
     let series = |s: usize| -> &[f64] { values.get(s * n..(s + 1) * n).unwrap_or(&[]) };
-    let num = |v: &f64| {
-        if v.is_finite() {
-            format!("{v:.5e}")
-        } else {
-            "null".into()
-        }
-    };
     let ext = &sys.spec.external;
-    let vessels: Vec<String> = (0..h.n_vessels as usize)
+    let n_vessels = (h.n_vessels as usize).min(h.horizon_s.len());
+    let vessels: Vec<Value> = (0..n_vessels)
         .map(|b| {
             let name = sys.spec.bodies.get(b).map(|x| x.name.as_str()).unwrap_or("?");
-            let dofs: Vec<String> = (0..6)
+            let dofs: Map<String, Value> = Dof::ALL
+                .iter()
                 .map(|d| {
-                    let v: Vec<String> = series(6 * b + d).iter().map(num).collect();
-                    format!("\"{}\":[{}]", DOF[d], v.join(","))
+                    let v: Vec<Value> = series(6 * b + d.index())
+                        .iter()
+                        .map(|x| finite(d.to_output(*x)))
+                        .collect();
+                    (d.output_name().to_string(), Value::Array(v))
                 })
                 .collect();
-            // points of interest on this vessel: displacement (x, y, z) over time
-            let points: Vec<String> = ext
+            let points: Map<String, Value> = ext
                 .points
                 .iter()
                 .filter(|p| p.body == b)
                 .map(|p| {
                     let mut comps = [vec![], vec![], vec![]];
-                    let mut x = vec![0.0; 6 * h.n_vessels as usize];
+                    let mut x = vec![0.0; 6 * n_vessels];
                     for k in 0..n {
                         for (i, xi) in x.iter_mut().enumerate() {
                             *xi = series(i).get(k).copied().unwrap_or(0.0);
                         }
                         let m = ext.point_motion(p, &x);
                         for c in 0..3 {
-                            comps[c].push(num(&m[c]));
+                            comps[c].push(finite(m[c]));
                         }
                     }
-                    format!(
-                        "\"{}\":{{\"x\":[{}],\"y\":[{}],\"z\":[{}]}}",
-                        p.name,
-                        comps[0].join(","),
-                        comps[1].join(","),
-                        comps[2].join(",")
-                    )
+                    let [x_m, y_m, z_m] = comps;
+                    (p.name.clone(), json!({"x_m": x_m, "y_m": y_m, "z_m": z_m}))
                 })
                 .collect();
-            format!(
-                "{{\"name\":\"{name}\",\"horizon_s\":{:.1},\"dofs\":{{{}}},\"points\":{{{}}}}}",
-                h.horizon_s[b],
-                dofs.join(","),
-                points.join(",")
-            )
+            json!({"name": name, "horizon_s": finite(h.horizon_s[b]), "dofs": dofs, "points": points})
         })
         .collect();
-    let fl: Vec<String> = flags::names(h.flags).iter().map(|n| format!("\"{n}\"")).collect();
-    format!(
-        "{{\"kind\":\"forecast\",\"issue_time_s\":{:.3},\"dt_s\":{},\"wave_time_s\":{:.3},\"compute_ms\":{:.3},\"received_wall_s\":{:.3},\"vessels\":[{}],\"flags\":[{}]}}",
-        h.issue_time_s,
-        h.dt_s,
-        h.wave_time_s,
-        h.compute_ms,
-        service::wall_s(),
-        vessels.join(","),
-        fl.join(",")
-    )
+    json!({
+        "kind": "forecast",
+        "issue_time_s": finite(h.issue_time_s),
+        "dt_s": finite(h.dt_s),
+        "wave_time_s": finite(h.wave_time_s),
+        "compute_ms": finite(h.compute_ms),
+        "received_wall_s": finite(service::wall_s()),
+        "vessels": vessels,
+        "flags": flags::names(h.flags),
+    })
+    .to_string()
 }
 
+/// A status as one JSON line (`watch --json`); non-finite numbers as null.
 pub fn status_json(s: &Status, n_vessels: usize) -> String {
-    let fl: Vec<String> = flags::names(s.flags).iter().map(|n| format!("\"{n}\"")).collect();
-    let list = |a: &[f64]| {
-        a[..n_vessels]
-            .iter()
-            .map(|v| format!("{v:.3}"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    format!(
-        "{{\"kind\":\"status\",\"running\":{},\"time_s\":{:.3},\"wall_time_s\":{:.3},\"wave_age_s\":{:.3},\"motion_age_s\":[{}],\"motion_rate_hz\":[{}],\"last_forecast_time_s\":{:.3},\"last_compute_ms\":{:.3},\"horizon_s\":[{}],\"forecasts\":{},\"overruns\":{},\"samples\":{},\"wave_fields\":{},\"dropped_nonfinite\":{},\"dropped_late\":{},\"dropped_duplicate\":{},\"flags\":[{}]}}",
-        s.running == 1,
-        s.time_s,
-        s.wall_time_s,
-        s.wave_age_s,
-        list(&s.motion_age_s),
-        list(&s.motion_rate_hz),
-        s.last_forecast_time_s,
-        s.last_compute_ms,
-        list(&s.horizon_s),
-        s.forecasts,
-        s.overruns,
-        s.samples,
-        s.wave_fields,
-        s.dropped_nonfinite,
-        s.dropped_late,
-        s.dropped_duplicate,
-        fl.join(",")
-    )
+    let list = |a: &[f64]| a.iter().take(n_vessels).map(|v| finite(*v)).collect::<Vec<_>>();
+    serde_json::json!({
+        "kind": "status",
+        "running": s.running == 1,
+        "time_s": finite(s.time_s),
+        "wall_time_s": finite(s.wall_time_s),
+        "wave_age_s": finite(s.wave_age_s),
+        "motion_age_s": list(&s.motion_age_s),
+        "motion_rate_hz": list(&s.motion_rate_hz),
+        "last_forecast_time_s": finite(s.last_forecast_time_s),
+        "last_compute_ms": finite(s.last_compute_ms),
+        "horizon_s": list(&s.horizon_s),
+        "forecasts": s.forecasts,
+        "overruns": s.overruns,
+        "samples": s.samples,
+        "wave_fields": s.wave_fields,
+        "dropped_nonfinite": s.dropped_nonfinite,
+        "dropped_late": s.dropped_late,
+        "dropped_duplicate": s.dropped_duplicate,
+        "flags": flags::names(s.flags),
+    })
+    .to_string()
 }
 
 pub fn watch(a: &WatchArgs) -> Result<()> {
     let cfg = load_config(&a.config)?;
-    let sys = files::load_system(&system_path(&cfg))?.system;
+    let sys = load_system(&cfg)?;
     let sub = ForecastSubscriber::new(&Names {
         prefix: cfg.ipc.service_prefix.clone(),
     })
@@ -421,8 +426,8 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
                     } else {
                         let n = h.steps as usize + 1;
                         let mut line = format!(
-                            "forecast t0 {:.1} s, {:.0} s ahead, computed in {:.1} ms",
-                            h.issue_time_s,
+                            "forecast issued {}, {:.0} s ahead, computed in {:.1} ms",
+                            super::utc(h.issue_time_s),
                             h.steps as f64 * h.dt_s,
                             h.compute_ms
                         );
@@ -466,10 +471,10 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
 
 #[derive(Args, Debug)]
 pub struct DemoArgs {
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Stop after this many seconds (default: until Ctrl-C).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
 }
 
@@ -480,9 +485,9 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     use shipcast::ipc::MotionSubscriber;
     use shipcast::process::Interrupting;
     let cfg = load_config(&a.config)?;
-    let sys = files::load_system(&system_path(&cfg))?.system;
+    let sys = load_system(&cfg)?;
     let exe = std::env::current_exe()?;
-    let config = a.config.to_str().context("config path is not UTF-8")?.to_string();
+    let config = cfg.path.to_str().context("config path is not UTF-8")?.to_string();
     let spawn = |args: &[&str]| -> Result<Interrupting> {
         Ok(Interrupting(
             std::process::Command::new(&exe)

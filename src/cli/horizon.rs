@@ -17,31 +17,31 @@ pub enum Spectrum {
 #[derive(Args, Debug)]
 pub struct HorizonArgs {
     /// Radius of the observed disc around the vessel (the radar's range), m.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     radius: f64,
     /// Peak period, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     tp: f64,
     /// Significant wave height, m (the horizon does not depend on it; reported).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
     hs: f64,
     #[arg(long, value_enum, default_value = "jonswap")]
     spectrum: Spectrum,
     /// cos-2s spreading exponent s (omit for long-crested waves; 0 for cos^2 spreading).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     spreading: Option<f64>,
     /// Mean wave heading relative to the vessel, deg: the direction the waves travel to,
     /// counterclockwise from the bow (180 = head seas).
-    #[arg(long, default_value_t = 180.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 180.0)]
     heading: f64,
     /// Vessel speed along its heading, m/s.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     speed: f64,
     /// Water depth, m (omit for deep water).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     depth: Option<f64>,
     /// Non-causal reach of the vessel's force RAO, s (taken off the waves' horizon).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     noncausal: f64,
 }
 

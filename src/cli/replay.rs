@@ -1,6 +1,6 @@
 //! `shipcast replay LOG`: a recorded log through the daemon's engine, with a skill report.
 
-use super::daemon::{DEFAULT_CONFIG, load_config};
+use super::daemon::load_config;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
@@ -17,10 +17,10 @@ pub struct ReplayArgs {
     /// are replayed as one.
     #[arg(required = true)]
     log: Vec<PathBuf>,
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Log seconds per wall second (default: as fast as possible).
-    #[arg(long, conflicts_with = "max")]
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "max")]
     speed: Option<f64>,
     /// As fast as possible (the default).
     #[arg(long)]
@@ -38,20 +38,38 @@ pub struct ReplayArgs {
     /// Publish the replay over iceoryx2 (motion, forecasts, status) under this service prefix, for
     /// a console (`shipcast console --prefix P`); default prefix `<ipc.service_prefix>-replay`. Use
     /// with --speed.
-    #[arg(long, num_args = 0..=1, default_missing_value = "")]
+    #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "", value_name = "PREFIX")]
     publish: Option<String>,
     /// With --report: also plot the forecast issued nearest this time (the sensors' clock, as
     /// forecasts' issue times) against what followed (`forecast-<t>.svg`); repeatable. Default: the
     /// middle forecast of the log.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     at: Vec<f64>,
 }
 
 const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
 
+/// MCAP's magic number, the first and last 8 bytes of every MCAP file.
+const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+
+/// Refuses, with the path, a file that does not start as an MCAP file (before reading any of it).
+fn is_mcap(path: &std::path::Path) -> Result<()> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let mut f = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let n = f.read(&mut head).with_context(|| path.display().to_string())?;
+    if n < 8 || &head != MCAP_MAGIC {
+        bail!(
+            "{}: not an MCAP log (it does not start with MCAP's magic bytes); logs come from `shipcast simulate --record`, `shipcast import` or the daemon's [record] dir",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(a: &ReplayArgs) -> Result<()> {
     let cfg = load_config(&a.config)?;
-    let sys = shipcast::files::load_system(&cfg.dir.join(&cfg.system.file))?.system;
+    let sys = super::daemon::load_system(&cfg)?;
     if let Some(s) = a.speed
         && !(s.is_finite() && s > 0.0)
     {
@@ -61,6 +79,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     // their first message (each file's own order is kept: it is the order the daemon saw)
     let mut parts = vec![];
     for p in &a.log {
+        is_mcap(p)?;
         parts.push(replay::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
     }
     parts.sort_by(|x, y| {
@@ -157,7 +176,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     if let Some(dir) = &a.report {
         report(dir, &sys, &log.records, &forecasts, cfg.forecast.horizon_s)?;
         let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
-        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &a.config)?;
+        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
         // windows are scored against the true motion when the log has it (a simulation), else the
         // measured: IMU noise near a limit breaks windows that the motion itself kept
         let truth = measured_series(&log.records, vessels.len(), true);
@@ -611,8 +630,8 @@ pub struct ImportArgs {
     /// The log to write (MCAP).
     #[arg(long)]
     out: PathBuf,
-    #[arg(long, default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
+    #[command(flatten)]
+    config: super::ConfigArg,
     /// Motion CSV (layout: `src/replay/import.rs`); repeatable.
     #[arg(long)]
     motion: Vec<PathBuf>,
@@ -620,13 +639,13 @@ pub struct ImportArgs {
     #[arg(long)]
     probe: Vec<PathBuf>,
     /// Compass direction the waves travel to, for probe files without a towards_deg column.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     towards_deg: Option<f64>,
     /// A field every this many seconds of a probe record.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
     probe_period: f64,
     /// ... fitted to this many seconds of it.
-    #[arg(long, default_value_t = 120.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 120.0)]
     probe_window: f64,
     /// Frequencies kept from a probe record, rad/s.
     #[arg(long, default_value = "0.25:1.6")]
@@ -637,7 +656,7 @@ pub struct ImportArgs {
 pub fn import(a: &ImportArgs) -> Result<()> {
     use shipcast::replay::import::{ProbeOptions, motion_csv, probe_csv, probe_fields};
     let cfg = load_config(&a.config)?;
-    let sys = shipcast::files::load_system(&cfg.dir.join(&cfg.system.file))?.system;
+    let sys = super::daemon::load_system(&cfg)?;
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
     if a.motion.is_empty() && a.probe.is_empty() {
         bail!("nothing to import: give --motion and/or --probe files");

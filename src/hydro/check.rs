@@ -265,6 +265,25 @@ pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
     format!("{body}.{}", Dof::of_index(i).name())
 }
 
+/// The output column of state `i` with its unit (`carrier.heave_m`, `carrier.roll_deg`,
+/// `<tank>.tank_angle_deg`), as CSV and JSON outputs write it; [`output_value`] converts the value.
+pub fn output_label(sys: &VesselSystem, i: usize) -> String {
+    if i >= sys.n_modes() {
+        return format!("{}_deg", mode_label(sys, i));
+    }
+    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
+    format!("{body}.{}", Dof::of_index(i).output_name())
+}
+
+/// State `i`'s value (m or rad) in the unit of its [`output_label`] (m or deg; a tank angle in deg).
+pub fn output_value(sys: &VesselSystem, i: usize, si: f64) -> f64 {
+    if i >= sys.n_modes() {
+        si.to_degrees()
+    } else {
+        Dof::of_index(i).to_output(si)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -60,6 +60,24 @@ impl Dof {
         self as usize
     }
 
+    /// Name with the unit its values are written in by CSV and JSON outputs (`surge_m` .. `yaw_deg`):
+    /// the edges speak degrees (DESIGN.md section 1), the core radians.
+    pub fn output_name(self) -> &'static str {
+        match self {
+            Dof::Surge => "surge_m",
+            Dof::Sway => "sway_m",
+            Dof::Heave => "heave_m",
+            Dof::Roll => "roll_deg",
+            Dof::Pitch => "pitch_deg",
+            Dof::Yaw => "yaw_deg",
+        }
+    }
+
+    /// A value in the core's unit (m or rad) in the unit of [`Dof::output_name`] (m or deg).
+    pub fn to_output(self, si: f64) -> f64 {
+        if self.is_rotation() { si.to_degrees() } else { si }
+    }
+
     /// Translations are in m, rotations in rad.
     pub fn is_rotation(self) -> bool {
         self.index() >= 3

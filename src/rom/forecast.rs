@@ -11,6 +11,11 @@ use num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
+/// The longest forecast, s: the daemon's `forecast.horizon_s`, a scenario's `horizon_s` and the CLI's
+/// `--horizon` are all bounded by it. No radar-observed sea is predictable for more than minutes; the
+/// bound keeps the forecast's buffers (steps x states) sized by input within reason.
+pub const MAX_FORECAST_LENGTH_S: f64 = 3600.0;
+
 /// What a forecast needs, for the active DOFs of the model (in `model.active` order).
 #[derive(Debug, Clone, Copy)]
 pub struct ForecastRequest<'a> {
@@ -165,9 +170,9 @@ impl Forecaster {
     pub fn forecast(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<&Forecast> {
         let n = model.n();
         let dt = model.opts.dt_s;
-        if !(req.horizon_s.is_finite() && req.horizon_s > 0.0 && req.horizon_s <= 86_400.0) {
+        if !(req.horizon_s.is_finite() && req.horizon_s > 0.0 && req.horizon_s <= MAX_FORECAST_LENGTH_S) {
             return Err(Error::Input(format!(
-                "horizon {} s: must be in (0, 86400] s",
+                "forecast length {} s: must be in (0, {MAX_FORECAST_LENGTH_S}] s",
                 req.horizon_s
             )));
         }

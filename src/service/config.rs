@@ -28,6 +28,9 @@ pub struct ShipcastConfig {
     /// Directory of the config file (relative paths are resolved against it); set by [`load`].
     #[serde(skip)]
     pub dir: PathBuf,
+    /// The config file itself, as given; set by [`load`] (for messages that name it).
+    #[serde(skip)]
+    pub path: PathBuf,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -404,33 +407,72 @@ pub enum Error {
     Key { file: String, key: String, msg: String },
 }
 
-/// Reads the file, overlays `SHIPCAST_*` variables, validates.
-pub fn load(path: &Path) -> Result<ShipcastConfig, Error> {
+/// The environment variables that overlay the file: `SHIPCAST_<SECTION>__<KEY>` (e.g.
+/// `SHIPCAST_FORECAST__PERIOD_S=0.5`). `SHIPCAST_CONFIG` (the file's path, read by the CLI) and
+/// `SHIPCAST_LOG` are not keys and are left out.
+pub const ENV_PREFIX: &str = "SHIPCAST_";
+const ENV_NOT_KEYS: [&str; 2] = ["SHIPCAST_CONFIG", "SHIPCAST_LOG"];
+
+/// Reads the file, overlays the `SHIPCAST_*` variables of `env` (name, value), validates. An error in
+/// the file names the file; an error an environment variable brings in names that variable.
+pub fn load_with_env(path: &Path, env: &[(String, String)]) -> Result<ShipcastConfig, Error> {
     let file = path.display().to_string();
-    let raw = config::Config::builder()
-        .add_source(config::File::from(path).format(config::FileFormat::Toml).required(true))
-        .add_source(
-            config::Environment::with_prefix("SHIPCAST")
-                .prefix_separator("_")
-                .separator("__")
-                .try_parsing(true),
-        )
-        .build()
-        .map_err(|e| Error::Read {
-            file: file.clone(),
-            msg: e.to_string(),
-        })?;
-    let mut cfg: ShipcastConfig = raw.try_deserialize().map_err(|e| Error::Read {
+    let vars: Vec<&(String, String)> = env
+        .iter()
+        .filter(|(k, _)| k.starts_with(ENV_PREFIX) && !ENV_NOT_KEYS.contains(&k.as_str()))
+        .collect();
+    let build = |vars: &[&(String, String)]| -> Result<ShipcastConfig, String> {
+        let map: config::Map<String, String> = vars.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+        config::Config::builder()
+            .add_source(config::File::from(path).format(config::FileFormat::Toml).required(true))
+            .add_source(
+                config::Environment::with_prefix(ENV_PREFIX.trim_end_matches('_'))
+                    .prefix_separator("_")
+                    .separator("__")
+                    .try_parsing(true)
+                    .source(Some(map)),
+            )
+            .build()
+            .and_then(|raw| raw.try_deserialize())
+            .map_err(|e| e.to_string())
+    };
+    let mut cfg = build(&[]).map_err(|msg| Error::Read {
         file: file.clone(),
-        msg: e.to_string(),
+        msg,
     })?;
+    if !vars.is_empty() {
+        cfg = build(&vars).map_err(|msg| {
+            // name the variable: the first that fails on its own, else all of them
+            let culprit = vars
+                .iter()
+                .find(|v| build(&[**v]).is_err())
+                .map(|(k, v)| format!("environment variable {k}={v:?}"))
+                .unwrap_or_else(|| {
+                    let names: Vec<&str> = vars.iter().map(|(k, _)| k.as_str()).collect();
+                    format!("environment variables {}", names.join(", "))
+                });
+            Error::Read {
+                file: culprit,
+                msg: format!(
+                    "{msg} (overlaying {file}; keys are SHIPCAST_<SECTION>__<KEY>, e.g. SHIPCAST_FORECAST__PERIOD_S)"
+                ),
+            }
+        })?;
+    }
     cfg.dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    cfg.path = path.to_path_buf();
     validate(&cfg).map_err(|(key, msg)| Error::Key {
         file: file.clone(),
         key,
         msg,
     })?;
     Ok(cfg)
+}
+
+/// [`load_with_env`] with the process's environment.
+pub fn load(path: &Path) -> Result<ShipcastConfig, Error> {
+    let env: Vec<(String, String)> = std::env::vars().collect();
+    load_with_env(path, &env)
 }
 
 fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
@@ -455,10 +497,14 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             format!("must be in (0, 1], found {}", f.wave_variance_kept),
         ));
     }
-    if f.horizon_s > 3600.0 {
+    if f.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
         return Err((
             "forecast.horizon_s".into(),
-            format!("at most 3600 s, found {}", f.horizon_s),
+            format!(
+                "at most {} s, found {}",
+                crate::rom::forecast::MAX_FORECAST_LENGTH_S,
+                f.horizon_s
+            ),
         ));
     }
     if !["convolution", "state-space"].contains(&f.radiation.as_str()) {
