@@ -69,7 +69,35 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
         eprintln!("{}", err.lines().last().unwrap_or(""));
         let j: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(rep.join("skill.json")).unwrap()).unwrap();
-        assert!(rep.join("skill.csv").exists() && rep.join("skill.svg").exists());
+        assert!(rep.join("skill.csv").exists());
+        // every plot as SVG (labelled axes, legend) and as a PNG that decodes
+        let plot_ok = |svg: &Path, labels: &[&str]| {
+            let text = std::fs::read_to_string(svg).unwrap();
+            for l in labels {
+                assert!(text.contains(l), "{} lacks {l:?}", svg.display());
+            }
+            let png = svg.with_extension("png");
+            let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+            let mut r = dec.read_info().unwrap();
+            let mut buf = vec![0; r.output_buffer_size()];
+            let info = r.next_frame(&mut buf).unwrap();
+            assert!(
+                info.width >= 800 && info.height >= 600,
+                "{}: {}x{}",
+                png.display(),
+                info.width,
+                info.height
+            );
+        };
+        plot_ok(
+            &rep.join("skill.svg"),
+            &[
+                "lead time (s)",
+                "correlation (forecast, measured)",
+                "NRMSE (RMS error / measured std)",
+                "carrier heave",
+            ],
+        );
         // operator windows (default channels: heave 1 m, roll 2 deg) against the simulation's truth
         let w: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(rep.join("windows.json")).unwrap()).unwrap();
@@ -80,13 +108,27 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
         let svg = std::fs::read_dir(&rep)
             .unwrap()
             .map(|e| e.unwrap().path())
-            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("forecast-"))
+            .find(|p| {
+                let n = p.file_name().unwrap().to_string_lossy();
+                n.starts_with("forecast-") && n.ends_with(".svg")
+            })
             .expect("a forecast-<t>.svg");
         let t: f64 = svg.file_stem().unwrap().to_string_lossy()["forecast-".len()..]
             .parse()
             .unwrap();
         assert!((250.0..350.0).contains(&t), "{t}");
-        assert!(std::fs::read_to_string(&svg).unwrap().contains("carrier.heave"));
+        plot_ok(
+            &svg,
+            &[
+                "lead time (s)",
+                "carrier.heave (m)",
+                "carrier.roll (deg)",
+                "truth motion",
+                "forecast (trusted)",
+                "limits ±1 m",
+                "trusted horizon",
+            ],
+        );
         let forecasts: Vec<shipcast::replay::ForecastRecord> = shipcast::replay::read(&out)
             .unwrap()
             .records

@@ -1,8 +1,10 @@
-//! Subcommands of the `shipcast` binary that have grown past a few lines (shell: wiring only).
+//! Subcommands of the `shipcast` binary that have grown past a few lines, and the replay report's
+//! plots (shell: wiring and files only).
 
 pub mod console;
 pub mod daemon;
 pub mod horizon;
+pub mod plot;
 pub mod replay;
 
 use std::path::PathBuf;

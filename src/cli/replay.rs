@@ -1,6 +1,7 @@
 //! `shipcast replay LOG`: a recorded log through the daemon's engine, with a skill report.
 
 use super::daemon::load_config;
+use super::plot;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
@@ -25,7 +26,7 @@ pub struct ReplayArgs {
     /// As fast as possible (the default).
     #[arg(long)]
     max: bool,
-    /// Write skill.json, skill.csv and skill.svg here.
+    /// Write skill.json, skill.csv, skill.svg and skill.png here (and windows.json, forecast-<t>.svg/.png).
     #[arg(long)]
     report: Option<PathBuf>,
     /// Write the replayed forecasts to this log.
@@ -41,7 +42,7 @@ pub struct ReplayArgs {
     #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "", value_name = "PREFIX")]
     publish: Option<String>,
     /// With --report: also plot the forecast issued nearest this time (the sensors' clock, as
-    /// forecasts' issue times) against what followed (`forecast-<t>.svg`); repeatable. Default: the
+    /// forecasts' issue times) against what followed (`forecast-<t>.svg` and `.png`); repeatable. Default: the
     /// middle forecast of the log.
     #[arg(long, allow_negative_numbers = true)]
     at: Vec<f64>,
@@ -210,8 +211,8 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
                 .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
             {
                 let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s));
-                std::fs::write(&p, forecast_svg(f, &sys, &channels, &measured, reference))?;
-                println!("forecast against actual: {}", p.display());
+                forecast_plot(&p, f, &sys, &channels, &measured, reference)?;
+                println!("forecast against actual: {} (and .png)", p.display());
             }
         }
     }
@@ -389,89 +390,56 @@ fn windows_report(
     Ok(())
 }
 
-/// One forecast against what followed, a panel per operation channel: measured (black), forecast
-/// (blue, dashed past the trusted horizon), limits (red). Hand-written SVG like [`svg`].
-fn forecast_svg(
+/// One forecast against what followed, a panel per operation channel (display units), plotted by
+/// [`plot::forecast`] into `svg` and the PNG beside it.
+fn forecast_plot(
+    svg: &Path,
     f: &ForecastRecord,
     sys: &shipcast::hydro::VesselSystem,
     channels: &[Channel],
     measured: &[Vec<(f64, f64)>],
     reference: &str,
-) -> String {
+) -> Result<()> {
     let ext = &sys.spec.external;
     let n = f.steps as usize + 1;
     let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
-    let (w, ph, m) = (900.0, 200.0, 60.0);
-    let h = m + ph * channels.len() as f64 + 20.0;
     let span = (n - 1) as f64 * f.dt_s;
-    let x = |t: f64| m + (w - 2.0 * m) * t / span.max(1.0);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{m}\" y=\"20\">forecast issued at {:.1} s against the {reference} motion: blue forecast (dashed: past the trusted horizon), red limits</text>\n",
-        f.issue_time_s
-    );
     let mut xs = vec![0.0; series.len()];
-    for (c, ch) in channels.iter().enumerate() {
-        let top = 40.0 + ph * c as f64;
-        let fc = ch.along(ext, &series);
-        let meas: Vec<(f64, f64)> = (0..n)
-            .filter_map(|k| {
-                let t = f.issue_time_s + k as f64 * f.dt_s;
-                for (xi, sr) in xs.iter_mut().zip(measured) {
-                    *xi = skill::interpolate(sr, t)?;
-                }
-                Some((k as f64 * f.dt_s, ch.value(ext, &xs)))
-            })
-            .collect();
-        let peak = fc
-            .iter()
-            .chain(meas.iter().map(|p| &p.1))
-            .filter(|v| v.is_finite())
-            .fold(ch.limit * 1.2, |a, v| a.max(v.abs()));
-        let y = |v: f64| top + ph / 2.0 - (ph / 2.0 - 15.0) * v / peak;
-        let trusted = ch.horizon_s(ext, &f.horizon_s).min(span);
-        s.push_str(&format!(
-            "<text x=\"{m}\" y=\"{}\">{} ({}), limit ±{}, trusted {trusted:.0} s</text>\n",
-            top + 12.0,
-            ch.name,
-            ch.unit(),
-            ch.limit
-        ));
-        for l in [ch.limit, -ch.limit] {
-            s.push_str(&format!(
-                "<line x1=\"{m}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"red\"/>\n",
-                y(l),
-                w - m
-            ));
-        }
-        s.push_str(&format!(
-            "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#999\" stroke-dasharray=\"2,3\"/>\n",
-            x(trusted),
-            top + 15.0,
-            top + ph - 15.0
-        ));
-        let poly = |pts: &[(f64, f64)], style: &str| {
-            let p: Vec<String> = pts
-                .iter()
-                .filter(|(_, v)| v.is_finite())
-                .map(|(t, v)| format!("{:.1},{:.1}", x(*t), y(*v)))
+    let panels: Vec<plot::ForecastPanel> = channels
+        .iter()
+        .map(|ch| {
+            let actual = (0..n)
+                .map(|k| {
+                    let t = f.issue_time_s + k as f64 * f.dt_s;
+                    // NaN (a gap in the line) where a series has no sample around t
+                    let v = xs
+                        .iter_mut()
+                        .zip(measured)
+                        .try_for_each(|(xi, sr)| {
+                            *xi = skill::interpolate(sr, t)?;
+                            Some(())
+                        })
+                        .map_or(f64::NAN, |()| ch.value(ext, &xs));
+                    (k as f64 * f.dt_s, v)
+                })
                 .collect();
-            format!("<polyline fill=\"none\" {style} points=\"{}\"/>\n", p.join(" "))
-        };
-        let k_h = shipcast::operation::trusted_samples(n, f.dt_s, trusted);
-        let pts: Vec<(f64, f64)> = fc.iter().enumerate().map(|(k, v)| (k as f64 * f.dt_s, *v)).collect();
-        s.push_str(&poly(&meas, "stroke=\"black\" stroke-width=\"1.5\""));
-        s.push_str(&poly(&pts[..k_h], "stroke=\"#1f77b4\" stroke-width=\"2\""));
-        s.push_str(&poly(
-            &pts[k_h.saturating_sub(1)..],
-            "stroke=\"#1f77b4\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"",
-        ));
-    }
-    s.push_str(&format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">lead time 0 to {span:.0} s</text>\n</svg>\n",
-        w / 2.0,
-        h - 5.0
-    ));
-    s
+            let forecast = ch
+                .along(ext, &series)
+                .into_iter()
+                .enumerate()
+                .map(|(k, v)| (k as f64 * f.dt_s, v))
+                .collect();
+            plot::ForecastPanel {
+                name: ch.name.clone(),
+                unit: ch.unit().into(),
+                limit: ch.limit,
+                trusted_s: ch.horizon_s(ext, &f.horizon_s).min(span),
+                forecast,
+                actual,
+            }
+        })
+        .collect();
+    plot::forecast(svg, f.issue_time_s, reference, span, &panels)
 }
 
 /// Skill of every vessel DOF against lead time, against the measured motion in the log.
@@ -488,7 +456,7 @@ fn report(
     let step = 5.0;
     let mut json_vessels = vec![];
     let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,count\n");
-    let mut curves: Vec<(String, Vec<f64>, Vec<f64>)> = vec![];
+    let mut curves: Vec<plot::SkillCurve> = vec![];
     let mut lead = vec![];
     for b in 0..nb {
         let name = &sys.spec.bodies[b].name;
@@ -536,7 +504,11 @@ fn report(
                 ));
             }
             if ["heave", "roll", "pitch"].contains(dof) {
-                curves.push((format!("{name} {dof}"), sk.correlation.clone(), sk.nrmse.clone()));
+                curves.push(plot::SkillCurve {
+                    label: format!("{name} {dof}"),
+                    correlation: sk.correlation.clone(),
+                    nrmse: sk.nrmse.clone(),
+                });
             }
         }
         json_vessels.push(format!("\"{name}\":{{{}}}", dofs.join(",")));
@@ -551,78 +523,14 @@ fn report(
         ),
     )?;
     std::fs::write(dir.join("skill.csv"), csv)?;
-    std::fs::write(dir.join("skill.svg"), svg(&lead, &curves))?;
+    plot::skill(&dir.join("skill.svg"), forecasts.len(), &lead, &curves)?;
     let mut out = std::io::stdout().lock();
-    writeln!(out, "report: {}/skill.json, skill.csv, skill.svg", dir.display())?;
+    writeln!(
+        out,
+        "report: {}/skill.json, skill.csv, skill.svg, skill.png",
+        dir.display()
+    )?;
     Ok(())
-}
-
-/// A plain SVG of correlation (solid) and normalized RMS error (dashed) against lead time. Hand-written:
-/// polylines and a few labels need no plotting library (and no fonts at build time).
-fn svg(lead: &[f64], curves: &[(String, Vec<f64>, Vec<f64>)]) -> String {
-    let (w, h, m) = (900.0, 500.0, 60.0);
-    let lmax = lead.last().copied().unwrap_or(1.0).max(1.0);
-    let x = |l: f64| m + (w - 2.0 * m) * l / lmax;
-    let y = |v: f64| h - m - (h - 2.0 * m) * v.clamp(0.0, 1.5) / 1.5;
-    let colours = [
-        "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#e377c2",
-    ];
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    );
-    s.push_str(&format!(
-        "<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/><line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>\n",
-        h - m,
-        w - m,
-        h - m,
-        h - m
-    ));
-    for v in [0.0, 0.5, 1.0, 1.5] {
-        s.push_str(&format!(
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{v}</text><line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"#ddd\"/>\n",
-            m - 5.0,
-            y(v) + 4.0,
-            y(v),
-            w - m,
-            y(v)
-        ));
-    }
-    let mut l = 0.0;
-    while l <= lmax + 1e-9 {
-        s.push_str(&format!(
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{l:.0}</text>\n",
-            x(l),
-            h - m + 18.0
-        ));
-        l += (lmax / 6.0).max(5.0).round();
-    }
-    s.push_str(&format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">lead time, s (solid: correlation; dashed: RMS error / measured std)</text>\n",
-        w / 2.0,
-        h - 15.0
-    ));
-    for (i, (name, corr, nrmse)) in curves.iter().enumerate() {
-        let c = colours[i % colours.len()];
-        for (vals, dash) in [(corr, ""), (nrmse, " stroke-dasharray=\"6,4\"")] {
-            let pts: Vec<String> = lead
-                .iter()
-                .zip(vals.iter())
-                .filter(|(_, v)| v.is_finite())
-                .map(|(l, v)| format!("{:.1},{:.1}", x(*l), y(*v)))
-                .collect();
-            s.push_str(&format!(
-                "<polyline fill=\"none\" stroke=\"{c}\" stroke-width=\"2\"{dash} points=\"{}\"/>\n",
-                pts.join(" ")
-            ));
-        }
-        s.push_str(&format!(
-            "<text x=\"{}\" y=\"{}\" fill=\"{c}\">{name}</text>\n",
-            w - m - 150.0,
-            m + 16.0 * i as f64
-        ));
-    }
-    s.push_str("</svg>\n");
-    s
 }
 
 #[derive(Args, Debug)]
