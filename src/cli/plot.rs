@@ -319,6 +319,8 @@ pub struct SkillCurve {
     pub nrmse: Vec<f64>,
 }
 
+type SkillPanel = (&'static str, String, f64, f64, fn(&SkillCurve) -> &Vec<f64>);
+
 struct SkillFigure<'a> {
     title: String,
     lead_s: &'a [f64],
@@ -351,7 +353,8 @@ impl Figure for SkillFigure<'_> {
         let n_max = finite(|c| &c.nrmse).fold(0.0, f64::max);
         let clipped = n_max > NRMSE_CLIP;
         let n_hi = if clipped { NRMSE_CLIP } else { (n_max * 1.08).max(0.1) };
-        let panels: [(&str, String, f64, f64, fn(&SkillCurve) -> &Vec<f64>); 2] = [
+        // per panel: y label, caption, y range, the curve's values
+        let panels: [SkillPanel; 2] = [
             (
                 "correlation (forecast, measured)",
                 "Correlation of forecast and measured motion".into(),
