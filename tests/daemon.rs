@@ -202,6 +202,33 @@ fn forecasts_over_iceoryx2_match_the_simulated_truth() {
     assert!(ch >= MIN_CORRELATION && cp >= MIN_CORRELATION);
 }
 
+/// Was: a `WatchdogSec` shorter than the forecast period was accepted, and systemd would kill a healthy
+/// daemon between two pings.
+#[test]
+fn a_watchdog_shorter_than_two_periods_is_refused_at_start() {
+    let dir = crate::util::scratch_dir("daemon-watchdog");
+    let cfg = config(&dir, "watchdog", "");
+    // the config's period is 0.5 s: a 0.8 s watchdog cannot be met; `exec` keeps the shell's pid,
+    // which WATCHDOG_PID must name
+    let out = Command::new("sh")
+        .args([
+            "-c",
+            &format!(
+                "WATCHDOG_PID=$$ WATCHDOG_USEC=800000 exec {} run --config {}",
+                bin(),
+                cfg.display()
+            ),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("forecast.period_s = 0.5 s") && err.contains("WatchdogSec is 0.8 s"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_config_with_a_wrong_key_or_type_is_refused() {
     let dir = crate::util::scratch_dir("daemon-badcfg");

@@ -425,8 +425,25 @@ impl Engine {
     }
 }
 
-/// Runs the daemon until SIGINT/SIGTERM.
+/// The daemon pings systemd's watchdog once per forecast period: a `WatchdogSec` shorter than two periods
+/// would have systemd kill a healthy daemon. `watchdog_s` is the unit's interval (None: no watchdog).
+pub fn watchdog_fits(period_s: f64, watchdog_s: Option<f64>) -> Result<(), String> {
+    match watchdog_s {
+        Some(w) if 2.0 * period_s > w => Err(format!(
+            "forecast.period_s = {period_s} s, but the unit's WatchdogSec is {w} s: the daemon pings the watchdog once \
+             a period, so WatchdogSec must be at least twice forecast.period_s ({} s)",
+            2.0 * period_s
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Runs the daemon until SIGINT/SIGTERM. Ends with an error (a non-zero exit: systemd restarts it) if
+/// the compute thread dies.
 pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) -> Result<(), Error> {
+    let mut watchdog_usec = 0u64;
+    let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
+    watchdog_fits(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6))?;
     let n_bodies = sys.spec.bodies.len();
     if n_bodies > MAX_VESSELS {
         return Err(format!("{n_bodies} vessels: the wire format carries at most {MAX_VESSELS}").into());
@@ -458,8 +475,6 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let (done_tx, mut done_rx) = tokio::sync::mpsc::channel::<Done>(4);
     let compute = compute_thread(Computer::new(model, n_bodies, cfg.forecast.horizon_s), job_rx, done_tx);
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
-    let mut watchdog_usec = 0u64;
-    let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
@@ -488,6 +503,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
             *recorder = None;
         }
     }
+    let mut failure: Option<&str> = None;
     loop {
         tokio::select! {
             _ = tokio::signal::ctrl_c() => { tracing::info!("SIGINT: stopping"); break; }
@@ -508,7 +524,11 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                 engine.input(msg, t);
             }
             done = done_rx.recv() => {
-                let Some(d) = done else { break };
+                let Some(d) = done else {
+                    tracing::error!("the compute thread has ended (a panic): stopping, with an error, so that systemd restarts shipcast");
+                    failure = Some("the compute thread ended unexpectedly");
+                    break;
+                };
                 if let Some(out) = engine.done(d) {
                     if let Output::Forecast(h, v) = &out {
                         let rec = crate::replay::Record::Forecast(crate::replay::ForecastRecord::of(h, v));
@@ -518,6 +538,11 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                 }
             }
             _ = tick.tick() => {
+                if compute.is_finished() {
+                    tracing::error!("the compute thread has ended (a panic): stopping, with an error, so that systemd restarts shipcast");
+                    failure = Some("the compute thread ended unexpectedly");
+                    break;
+                }
                 if watchdog {
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
@@ -552,7 +577,10 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
         samples = c.samples,
         "shipcast stopped"
     );
-    Ok(())
+    match failure {
+        Some(why) => Err(why.to_string().into()),
+        None => Ok(()),
+    }
 }
 
 /// A motion sample on the wire from the simulator's.
