@@ -162,3 +162,22 @@ fn a_bad_channel_or_colour_is_named_before_the_screen_opens() {
     let e = run("[console.colours]\nforecast = \"blurple\"\n");
     assert!(e.contains("console.colours.forecast") && e.contains("blurple"), "{e}");
 }
+
+/// Was: `shipcast demo` printed plain lines in a terminal too; the console was a separate command.
+/// Now in a terminal it opens the console on the demo, which says in words how long the warm-up lasts.
+#[test]
+fn demo_in_a_terminal_opens_the_console_and_says_when_the_warm_up_ends() {
+    let dir = scratch_dir("console-demo");
+    let cfg = config(&dir, "console-demo", "");
+    let tmux = Tmux::new(
+        "console-demo",
+        &format!("{} demo --config {} --seconds 40", bin(), cfg.display()),
+    );
+    let warm = |s: &str| s.contains("Warming up:") && s.contains("motion memory");
+    assert!(tmux.until(30.0, warm).is_some(), "{}", tmux.screen());
+    assert!(tmux.screen().contains("shipcast console"), "{}", tmux.screen());
+    Command::new("tmux")
+        .args(["send-keys", "-t", &tmux.0, "q"])
+        .status()
+        .unwrap();
+}

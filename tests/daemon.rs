@@ -229,6 +229,29 @@ fn a_watchdog_shorter_than_two_periods_is_refused_at_start() {
     );
 }
 
+/// Was: piped, each line of the demo was flagged `[history_short]` for the whole warm-up with no word
+/// of why or for how long.
+#[test]
+fn demo_piped_prints_lines_that_say_how_long_the_warm_up_lasts() {
+    let dir = crate::util::scratch_dir("daemon-demo");
+    let cfg = config(&dir, "demo", "");
+    let out = Command::new(bin())
+        .args(["demo", "--config", cfg.to_str().unwrap(), "--seconds", "15"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    // the test config's memory is 60 s, at 4x: the first forecasts are all within the warm-up
+    let line = text
+        .lines()
+        .find(|l| l.contains("heave now"))
+        .unwrap_or_else(|| panic!("no forecast line: {text}"));
+    assert!(
+        line.contains("warming up: the 60 s motion memory fills in") && line.contains("s more"),
+        "{line}"
+    );
+}
+
 #[test]
 fn a_config_with_a_wrong_key_or_type_is_refused() {
     let dir = crate::util::scratch_dir("daemon-badcfg");

@@ -111,9 +111,19 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
 }
 
 pub fn run(a: &ConsoleArgs) -> Result<()> {
-    use ratatui::crossterm::event::{self, KeyCode, KeyEventKind, KeyModifiers};
     let cfg = super::daemon::load_config(&a.config)?;
     let sys = super::daemon::load_system(&cfg)?;
+    view(&cfg, &sys, a.prefix.clone(), a.seconds)
+}
+
+/// The console on a loaded config and system (also what `shipcast demo` opens in a terminal).
+pub fn view(
+    cfg: &shipcast::service::config::ShipcastConfig,
+    sys: &shipcast::hydro::VesselSystem,
+    prefix: Option<String>,
+    seconds: Option<f64>,
+) -> Result<()> {
+    use ratatui::crossterm::event::{self, KeyCode, KeyEventKind, KeyModifiers};
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
     let ext = sys.spec.external.clone();
     let channels = cfg.operation_channels(&vessels, &ext, &cfg.path)?;
@@ -127,13 +137,14 @@ pub fn run(a: &ConsoleArgs) -> Result<()> {
         duration_s: cfg.operation.duration_s,
         history_s: cfg.console.history_s,
         period_s: cfg.forecast.period_s,
+        history_wanted_s: shipcast::service::history_wanted_s(cfg, sys),
         colours,
     };
     let mut console = Console::new(settings, vessels.clone(), ext);
     let (tx, rx) = mpsc::channel();
     let stop = Arc::new(AtomicBool::new(false));
     let names = Names {
-        prefix: a.prefix.clone().unwrap_or_else(|| cfg.ipc.service_prefix.clone()),
+        prefix: prefix.unwrap_or_else(|| cfg.ipc.service_prefix.clone()),
     };
     let thread = {
         let stop = stop.clone();
@@ -158,7 +169,7 @@ pub fn run(a: &ConsoleArgs) -> Result<()> {
             }
             let now = wall_s();
             terminal.draw(|f| shipcast::console::draw(f, &console, now))?;
-            if a.seconds.is_some_and(|s| started.elapsed().as_secs_f64() > s) {
+            if seconds.is_some_and(|s| started.elapsed().as_secs_f64() > s) {
                 return Ok(());
             }
             if event::poll(redraw)? {

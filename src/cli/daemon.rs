@@ -476,11 +476,15 @@ pub struct DemoArgs {
     /// Stop after this many seconds (default: until Ctrl-C).
     #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
+    /// Plain text lines even in a terminal (the default when the output is not a terminal).
+    #[arg(long)]
+    plain: bool,
 }
 
 /// `shipcast demo`: the synthetic sea publishing radar and IMU data, the daemon on the bundled demo,
-/// and a live view of the forecasts and of their skill so far (the forecasts of 30 s ago against the
-/// motion measured now). Ctrl-C stops all three.
+/// and, in a terminal, the operator console on it (else, or with --plain, a line per forecast with its
+/// skill so far: the forecasts of 30 s ago against the motion measured now). Ctrl-C (or q in the
+/// console) stops all three.
 pub fn demo(a: &DemoArgs) -> Result<()> {
     use shipcast::ipc::MotionSubscriber;
     use shipcast::process::Interrupting;
@@ -488,13 +492,23 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     let sys = load_system(&cfg)?;
     let exe = std::env::current_exe()?;
     let config = cfg.path.to_str().context("config path is not UTF-8")?.to_string();
+    use std::io::IsTerminal;
+    let console = !a.plain && std::io::stdout().is_terminal();
+    // under the console the children's logs would tear the screen: they go to a file
+    let log_path = std::env::temp_dir().join(format!("shipcast-demo-{}.log", std::process::id()));
+    let log = if console {
+        Some(std::fs::File::create(&log_path).with_context(|| log_path.display().to_string())?)
+    } else {
+        None
+    };
     let spawn = |args: &[&str]| -> Result<Interrupting> {
+        let mut cmd = std::process::Command::new(&exe);
+        cmd.args(args).stdout(std::process::Stdio::null());
+        if let Some(f) = &log {
+            cmd.stderr(f.try_clone()?);
+        }
         Ok(Interrupting(
-            std::process::Command::new(&exe)
-                .args(args)
-                .stdout(std::process::Stdio::null())
-                .spawn()
-                .with_context(|| format!("starting shipcast {}", args[0]))?,
+            cmd.spawn().with_context(|| format!("starting shipcast {}", args[0]))?,
         ))
     };
     let stop = Arc::new(AtomicBool::new(false));
@@ -515,6 +529,16 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     let _daemon = spawn(&["run", "--config", &config])?;
     std::thread::sleep(Duration::from_millis(1500));
     let _sim = spawn(&["simulate", "--publish", "--config", &config])?;
+    if console {
+        let r = super::console::view(&cfg, &sys, None, a.seconds);
+        println!(
+            "shipcast demo: stopping (the daemon's and the simulator's logs: {})",
+            log_path.display()
+        );
+        return r;
+    }
+    let wanted_s = shipcast::service::history_wanted_s(&cfg, &sys);
+    let mut first_motion_s: Option<f64> = None;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
     };
@@ -541,6 +565,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
         for s in samples.iter().filter(|s| s.vessel == 0) {
             measured.push_back((s.time_s, s.x[2]));
+            first_motion_s.get_or_insert(s.time_s);
         }
         while measured.len() > 5000 {
             measured.pop_front();
@@ -579,11 +604,21 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
                         pairs_f.len()
                     )
                 };
-                let fl = if h.flags != 0 {
+                let mut fl = if h.flags != 0 {
                     format!(" [{}]", flags::names(h.flags).join(", "))
                 } else {
                     String::new()
                 };
+                if h.flags & flags::HISTORY_SHORT != 0
+                    && let (Some(first), Some((last, _))) = (first_motion_s, measured.back())
+                {
+                    let left = wanted_s - (last - first);
+                    if left > 0.0 {
+                        fl.push_str(&format!(
+                            " warming up: the {wanted_s:.0} s motion memory fills in {left:.0} s more (forecasts less sure until then)"
+                        ));
+                    }
+                }
                 println!(
                     "{name0} heave now {:+.2} m, in {LEAD:.0} s {:+.2} m, horizon {:.0} s, computed in {:.0} ms; {skill}{fl}",
                     heave[0],

@@ -66,6 +66,9 @@ pub struct Settings {
     pub history_s: f64,
     /// The daemon's forecast period (its config), for staleness.
     pub period_s: f64,
+    /// The measured history the daemon's forecasts want behind them, s ([`crate::service::history_wanted_s`]):
+    /// how long the console says the warm-up lasts.
+    pub history_wanted_s: f64,
     pub colours: Colours,
 }
 
@@ -143,6 +146,8 @@ pub struct Console {
     pub health: Option<Health>,
     /// Combined measured displacements (6 per vessel, the newest of each) after every sample.
     measured: VecDeque<(f64, Vec<f64>)>,
+    /// The first measured time (every vessel seen), s: the start of the history the daemon has.
+    first_measured_s: Option<f64>,
     latest_x: Vec<f64>,
     seen: Vec<bool>,
     pub selected: usize,
@@ -175,6 +180,7 @@ impl Console {
             forecast: None,
             health: None,
             measured: VecDeque::new(),
+            first_measured_s: None,
             latest_x: vec![0.0; 6 * n],
             seen: vec![false; n],
             selected: 0,
@@ -198,11 +204,21 @@ impl Console {
         self.seen[vessel] = true;
         if self.seen.iter().all(|s| *s) {
             self.measured.push_back((t_s, self.latest_x.clone()));
+            self.first_measured_s.get_or_insert(t_s);
         }
         let keep_s = self.settings.history_s + self.forecast_span_s() + 10.0;
         while self.measured.front().is_some_and(|(t, _)| *t < t_s - keep_s) {
             self.measured.pop_front();
         }
+    }
+
+    /// While the daemon's history is shorter than it wants: how much measured motion there is and how
+    /// many seconds are still to come (from the motion this console has seen; None once it is full or
+    /// before any motion).
+    pub fn warmup(&self) -> Option<(f64, f64)> {
+        let have = self.latest_measured_s()? - self.first_measured_s?;
+        let left = self.settings.history_wanted_s - have;
+        (left > 0.0).then_some((have, left))
     }
 
     pub fn on_forecast(&mut self, f: Forecast) {
@@ -421,6 +437,7 @@ mod tests {
             duration_s: 30.0,
             history_s: 60.0,
             period_s: 1.0,
+            history_wanted_s: 600.0,
             colours: Colours::default(),
         };
         Console::new(s, vec!["a".into(), "b".into()], External::default())

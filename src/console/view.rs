@@ -177,7 +177,16 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
             });
         }
         if h.flags.contains(&"history_short") {
-            out.push((Severity::Caution, "Motion history still filling: less sure".into()));
+            out.push((
+                Severity::Caution,
+                match c.warmup() {
+                    Some((_, left)) => format!(
+                        "Warming up: {left:.0} s more until the {:.0} s motion memory is full; less sure until then",
+                        c.settings.history_wanted_s
+                    ),
+                    None => "Motion history short (a gap or a restart): less sure".into(),
+                },
+            ));
         }
         if h.flags.contains(&"history_gap") {
             out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));

@@ -51,6 +51,21 @@ pub fn rom_options(cfg: &ShipcastConfig) -> RomOptions {
     }
 }
 
+/// With the state-space radiation (whose modal states carry the memory), the measured history each
+/// forecast starts from when `forecast.memory_s` is not set, s.
+pub const STATE_SPACE_HISTORY_S: f64 = 120.0;
+
+/// How much measured motion a forecast wants behind it, s: the radiation memory (convolution) or the
+/// history the modal states are started from (state space). Until the history is this long, forecasts
+/// carry `history_short` (the missing past taken as at rest).
+pub fn history_wanted_s(cfg: &ShipcastConfig, sys: &VesselSystem) -> f64 {
+    match (cfg.forecast.memory_s, cfg.forecast.radiation.as_str()) {
+        (Some(m), _) => m,
+        (None, "state-space") => STATE_SPACE_HISTORY_S,
+        (None, _) => crate::hydro::check::memory_duration_s(sys),
+    }
+}
+
 /// Earth position (east, north) of each body's reference point and the system's heading (rad,
 /// counterclockwise from east).
 pub fn vessel_positions(cfg: &ShipcastConfig, sys: &VesselSystem) -> (Vec<[f64; 2]>, f64) {
@@ -212,7 +227,7 @@ impl Engine {
         let taps = match &model.kernel {
             crate::rom::model::Kernel::Convolution { taps, .. } => *taps,
             crate::rom::model::Kernel::StateSpace { .. } => {
-                (cfg.forecast.memory_s.unwrap_or(120.0) / cfg.forecast.dt_s).round() as usize
+                (cfg.forecast.memory_s.unwrap_or(STATE_SPACE_HISTORY_S) / cfg.forecast.dt_s).round() as usize
             }
         };
         let keep_s = taps as f64 * cfg.forecast.dt_s + cfg.forecast.history_margin_s;
