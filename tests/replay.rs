@@ -4,26 +4,14 @@
 use crate::util::{repo, scratch_dir, shipcast};
 use std::path::{Path, PathBuf};
 
+/// The README's skill-report config (`config/one-ship.toml`), copied into `dir` with its system path
+/// made absolute.
 fn config(dir: &Path) -> PathBuf {
-    let text = format!(
-        r#"
-[system]
-file = "{}"
-[forecast]
-horizon_s = 120.0
-memory_s = 60.0
-[simulate]
-damping_factor = 1.2
-seed = 5
-[simulate.sea]
-towards_deg = 270.0
-components = 120
-[simulate.radar]
-radius_m = 1000.0
-cells = 128
-"#,
-        repo("config/vessels/ship/system.toml").display()
+    let text = std::fs::read_to_string(repo("config/one-ship.toml")).unwrap().replace(
+        "file = \"vessels/ship/system.toml\"",
+        &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
     );
+    assert!(text.contains(&*repo("config/vessels").to_string_lossy()));
     let p = dir.join("shipcast.toml");
     std::fs::write(&p, text).unwrap();
     p
