@@ -15,6 +15,7 @@ mod forecast_cli;
 mod kramers_kronig;
 mod replay;
 mod rom;
+mod trust;
 mod waves_fields;
 mod wecsim_rm3;
 mod wecsim_rm3_3dof;

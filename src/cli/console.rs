@@ -86,7 +86,7 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                         })
                     }
                     Received::Status(s) => {
-                        if s.schema_version != SCHEMA_VERSION {
+                        if s.schema_version != shipcast::ipc::wire::STATUS_SCHEMA_VERSION {
                             continue;
                         }
                         let nv = n_vessels.min(s.motion_age_s.len());

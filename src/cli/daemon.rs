@@ -388,6 +388,11 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
         "dropped_nonfinite": s.dropped_nonfinite,
         "dropped_late": s.dropped_late,
         "dropped_duplicate": s.dropped_duplicate,
+        "dropped_future": s.dropped_future,
+        "dropped_past": s.dropped_past,
+        "dropped_rejected": s.dropped_rejected,
+        "clock_steps": s.clock_steps,
+        "dropped_wave_share": finite(s.dropped_wave_share),
         "flags": flags::names(s.flags),
     })
     .to_string()

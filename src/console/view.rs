@@ -188,6 +188,17 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
                 },
             ));
         }
+        for (flag, words) in [
+            ("clocks_disagree", "Sensor clocks disagree: no forecast"),
+            ("clock_step", "A sensor clock stepped: re-synchronized"),
+            ("wave_region_unknown", "Radar: field without its region: not trusted"),
+            ("no_wave_components", "Radar: an empty field: not trusted"),
+            ("waves_dropped", "Part of the sea is outside the vessel database"),
+        ] {
+            if h.flags.contains(&flag) {
+                out.push((Severity::Caution, words.into()));
+            }
+        }
         if h.flags.contains(&"history_gap") {
             out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));
         }

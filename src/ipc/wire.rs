@@ -19,7 +19,10 @@
 use crate::waves::field::FlatHeader;
 use iceoryx2::prelude::*;
 
+/// Schema version of the motion, waves and forecast payloads.
 pub const SCHEMA_VERSION: u32 = 1;
+/// Schema version of [`Status`] (2: the drop counters by reason and the clock steps).
+pub const STATUS_SCHEMA_VERSION: u32 = 2;
 /// Vessels a forecast or status can describe.
 pub const MAX_VESSELS: usize = 4;
 
@@ -39,6 +42,18 @@ pub mod flags {
     pub const HISTORY_GAP: u32 = 32;
     /// No motion for a vessel: no forecast.
     pub const NO_MOTION: u32 = 64;
+    /// The wave field says nothing about where it was observed (radius 0): trusted horizon 0.
+    pub const WAVE_REGION_UNKNOWN: u32 = 128;
+    /// The wave field has no components: a wave-free forecast, trusted horizon 0.
+    pub const NO_WAVE_COMPONENTS: u32 = 256;
+    /// Wave components outside the database's frequencies or headings were left out of the forecast;
+    /// beyond `forecast.max_dropped_wave_share` of the variance the trusted horizon is 0.
+    pub const WAVES_DROPPED: u32 = 512;
+    /// A source's clock stepped and it was re-synchronized (status only, for the period it happened).
+    pub const CLOCK_STEP: u32 = 1024;
+    /// The sources' clocks disagree (a wave field newer than the motion, or vessels' motion apart, by
+    /// more than the clocks' skew allows): no forecast.
+    pub const CLOCKS_DISAGREE: u32 = 2048;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -50,6 +65,11 @@ pub mod flags {
             (NO_WAVES, "no_waves"),
             (HISTORY_GAP, "history_gap"),
             (NO_MOTION, "no_motion"),
+            (WAVE_REGION_UNKNOWN, "wave_region_unknown"),
+            (NO_WAVE_COMPONENTS, "no_wave_components"),
+            (WAVES_DROPPED, "waves_dropped"),
+            (CLOCK_STEP, "clock_step"),
+            (CLOCKS_DISAGREE, "clocks_disagree"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)
@@ -151,9 +171,9 @@ pub struct ForecastHeader {
     pub horizon_s: [f64; MAX_VESSELS],
 }
 
-/// Health of the daemon, published every cycle. 208 bytes.
+/// Health of the daemon, published every cycle. 248 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("shipcast_Status_v1")]
+#[type_name("shipcast_Status_v2")]
 #[repr(C)]
 pub struct Status {
     pub schema_version: u32,
@@ -181,6 +201,16 @@ pub struct Status {
     pub dropped_nonfinite: u64,
     pub dropped_late: u64,
     pub dropped_duplicate: u64,
+    /// Samples and fields refused for a stamp beyond `forecast.max_clock_skew_s` ahead of their source.
+    pub dropped_future: u64,
+    /// ... or beyond `forecast.max_clock_lag_s` behind it.
+    pub dropped_past: u64,
+    /// Samples refused for an unknown schema version or a vessel index out of range.
+    pub dropped_rejected: u64,
+    /// Steps of a source's clock detected (the source re-synchronized).
+    pub clock_steps: u64,
+    /// Share of the last forecast's wave variance outside the database (left out), 0..1.
+    pub dropped_wave_share: f64,
     /// 1 while running, 0 in the last status before a clean shutdown.
     pub running: u32,
     pub reserved: u32,
@@ -195,6 +225,6 @@ mod tests {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
-        assert_eq!(std::mem::size_of::<Status>(), 208);
+        assert_eq!(std::mem::size_of::<Status>(), 248);
     }
 }

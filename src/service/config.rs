@@ -102,6 +102,17 @@ pub struct ForecastConfig {
     /// Of a received wave field, the largest components holding this fraction of its variance are kept
     /// (a radar inversion has one per wavenumber bin, mostly noise; the cost is linear in their number).
     pub wave_variance_kept: f64,
+    /// A sample or wave field stamped more than this ahead of its source's clock (as tracked by the
+    /// engine) is refused as from the future, s (`service::clock`).
+    pub max_clock_skew_s: f64,
+    /// ... or more than this behind it, as from the past, s.
+    pub max_clock_lag_s: f64,
+    /// This many refused samples in a row that agree are a step of the source's clock: it
+    /// re-synchronizes to them (its history restarts).
+    pub clock_resync_samples: u32,
+    /// A forecast whose wave field lost more than this share of its variance (components outside the
+    /// database's frequencies or headings) is not trusted (trusted horizon 0), 0..1.
+    pub max_dropped_wave_share: f64,
 }
 
 impl Default for ForecastConfig {
@@ -118,6 +129,10 @@ impl Default for ForecastConfig {
             max_gap_s: 1.0,
             history_margin_s: 10.0,
             wave_variance_kept: 0.995,
+            max_clock_skew_s: 1.0,
+            max_clock_lag_s: 30.0,
+            clock_resync_samples: 5,
+            max_dropped_wave_share: 0.1,
         }
     }
 }
@@ -495,6 +510,20 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         return Err((
             "forecast.wave_variance_kept".into(),
             format!("must be in (0, 1], found {}", f.wave_variance_kept),
+        ));
+    }
+    pos("forecast.max_clock_skew_s", f.max_clock_skew_s)?;
+    pos("forecast.max_clock_lag_s", f.max_clock_lag_s)?;
+    if !(1..=1000).contains(&f.clock_resync_samples) {
+        return Err((
+            "forecast.clock_resync_samples".into(),
+            format!("must be in 1..=1000, found {}", f.clock_resync_samples),
+        ));
+    }
+    if !(0.0..=1.0).contains(&f.max_dropped_wave_share) {
+        return Err((
+            "forecast.max_dropped_wave_share".into(),
+            format!("must be in [0, 1], found {}", f.max_dropped_wave_share),
         ));
     }
     if f.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {

@@ -12,6 +12,7 @@
 //! skipped (no pile-up). Every tick publishes a status; a forecast is published only when the inputs
 //! allow one (see [`crate::ipc::wire::flags`]).
 
+pub mod clock;
 pub mod config;
 pub mod history;
 
@@ -196,6 +197,25 @@ pub struct Counters {
     pub late: u64,
     pub duplicate: u64,
     pub rejected: u64,
+    /// Refused for a stamp ahead of / behind their source's clock (`clock`).
+    pub future: u64,
+    pub past: u64,
+    pub clock_steps: u64,
+}
+
+/// Logs the first of a kind of event, then every time its count reaches a power of ten, so that a
+/// flood of bad input is visible in the log without filling it.
+fn log_count(count: u64, what: &str) {
+    if count == 1 || (count >= 10 && power_of_ten(count)) {
+        tracing::warn!(count, "{what}");
+    }
+}
+
+fn power_of_ten(mut n: u64) -> bool {
+    while n >= 10 && n.is_multiple_of(10) {
+        n /= 10;
+    }
+    n == 1
 }
 
 /// The daemon's state and decisions, driven by a clock the caller supplies (seconds: monotonic wall
@@ -213,6 +233,18 @@ pub struct Engine {
     /// Clock time of each vessel's newest accepted sample.
     arrival: Vec<Option<f64>>,
     field: Option<WaveField>,
+    /// Each vessel's motion stream's clock, and the radar's.
+    motion_clock: Vec<clock::SourceClock>,
+    wave_clock: clock::SourceClock,
+    clock_rules: clock::ClockRules,
+    /// Motion kept per vessel, s.
+    keep_s: f64,
+    /// The database the forecasts use: which wave components it covers.
+    db: crate::hydro::db::HydroDb,
+    /// Share of the last forecast's wave variance outside the database.
+    dropped_wave_share: f64,
+    /// Whether the last tick could forecast (for the log line when that changes).
+    forecasting: Option<bool>,
     pub counters: Counters,
     busy: bool,
     last_forecast_time: f64,
@@ -244,6 +276,17 @@ impl Engine {
             hist: (0..n_bodies).map(|_| History::new(keep_s)).collect(),
             arrival: vec![None; n_bodies],
             field: None,
+            motion_clock: vec![clock::SourceClock::default(); n_bodies],
+            wave_clock: clock::SourceClock::default(),
+            clock_rules: clock::ClockRules {
+                max_skew_s: cfg.forecast.max_clock_skew_s,
+                max_lag_s: cfg.forecast.max_clock_lag_s,
+                resync_samples: cfg.forecast.clock_resync_samples,
+            },
+            keep_s,
+            db: model.db.clone(),
+            dropped_wave_share: 0.0,
+            forecasting: None,
             counters: Counters::default(),
             busy: false,
             last_forecast_time: -1.0,
@@ -258,7 +301,10 @@ impl Engine {
         self.taps as f64 * self.cfg.dt_s
     }
 
+    /// One input that arrived at `clock_s` (engine clock). Every stamp is judged against its source's
+    /// clock first ([`clock`]): refused samples never reach the history.
     pub fn input(&mut self, msg: Input, clock_s: f64) {
+        let rules = self.clock_rules;
         let c = &mut self.counters;
         match msg {
             Input::Motion(m) => {
@@ -266,7 +312,51 @@ impl Engine {
                 let b = m.vessel as usize;
                 if m.schema_version != SCHEMA_VERSION || b >= self.n_bodies {
                     c.rejected += 1;
+                    log_count(
+                        c.rejected,
+                        &format!(
+                            "motion sample refused: schema version {} (this daemon reads {SCHEMA_VERSION}), vessel {} of {}",
+                            m.schema_version, m.vessel, self.n_bodies
+                        ),
+                    );
                     return;
+                }
+                match self.motion_clock[b].judge(m.time_s, clock_s, &rules) {
+                    clock::Stamp::Accepted => {}
+                    clock::Stamp::NonFinite => {
+                        c.nonfinite += 1;
+                        log_count(
+                            c.nonfinite,
+                            &format!("vessel {b}: motion sample with a non-finite stamp refused"),
+                        );
+                        return;
+                    }
+                    clock::Stamp::Future { ahead_s } => {
+                        c.future += 1;
+                        log_count(
+                            c.future,
+                            &format!("vessel {b}: motion sample stamped {ahead_s:.3} s ahead of its clock refused"),
+                        );
+                        return;
+                    }
+                    clock::Stamp::Past { behind_s } => {
+                        c.past += 1;
+                        log_count(
+                            c.past,
+                            &format!("vessel {b}: motion sample stamped {behind_s:.3} s behind its clock refused"),
+                        );
+                        return;
+                    }
+                    clock::Stamp::Stepped { step_s } => {
+                        c.clock_steps += 1;
+                        self.state_flags |= flags::CLOCK_STEP;
+                        tracing::warn!(
+                            vessel = b,
+                            step_s,
+                            "motion clock stepped: re-synchronized, its history restarts"
+                        );
+                        self.hist[b] = History::new(self.keep_s);
+                    }
                 }
                 match self.hist[b].push(Sample {
                     time_s: m.time_s,
@@ -274,15 +364,57 @@ impl Engine {
                     v: m.v,
                 }) {
                     Ok(()) => self.arrival[b] = Some(clock_s),
-                    Err(Drop::NonFinite) => c.nonfinite += 1,
-                    Err(Drop::Late) => c.late += 1,
+                    Err(Drop::NonFinite) => {
+                        c.nonfinite += 1;
+                        log_count(
+                            c.nonfinite,
+                            &format!("vessel {b}: motion sample with a non-finite value refused"),
+                        );
+                    }
+                    Err(Drop::Late) => {
+                        c.late += 1;
+                        log_count(
+                            c.late,
+                            &format!("vessel {b}: motion sample older than the newest refused"),
+                        );
+                    }
                     Err(Drop::Duplicate) => c.duplicate += 1,
                 }
             }
             Input::Waves(f) => {
                 c.wave_fields += 1;
+                let stepped = match self.wave_clock.judge(f.time_s, clock_s, &rules) {
+                    clock::Stamp::Accepted => false,
+                    clock::Stamp::Stepped { step_s } => {
+                        c.clock_steps += 1;
+                        self.state_flags |= flags::CLOCK_STEP;
+                        tracing::warn!(step_s, "radar clock stepped: re-synchronized");
+                        true
+                    }
+                    clock::Stamp::NonFinite => {
+                        c.nonfinite += 1;
+                        log_count(c.nonfinite, "wave field with a non-finite stamp refused");
+                        return;
+                    }
+                    clock::Stamp::Future { ahead_s } => {
+                        c.future += 1;
+                        log_count(
+                            c.future,
+                            &format!("wave field stamped {ahead_s:.3} s ahead of the radar's clock refused"),
+                        );
+                        return;
+                    }
+                    clock::Stamp::Past { behind_s } => {
+                        c.past += 1;
+                        log_count(
+                            c.past,
+                            &format!("wave field stamped {behind_s:.3} s behind the radar's clock refused"),
+                        );
+                        return;
+                    }
+                };
                 let f = f.pruned(self.cfg.wave_variance_kept);
-                if self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+                if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
                     self.field = Some(f);
                 }
             }
@@ -313,13 +445,42 @@ impl Engine {
             .iter()
             .filter_map(|h| h.newest_time_s())
             .fold(f64::INFINITY, f64::min);
-        match self.field.as_ref().map(|f| t0 - f.time_s) {
+        // the sources' clocks must agree: vessels' newest motion within the staleness and the skew of
+        // each other, and no wave field from after the motion beyond the skew
+        let newest = self
+            .hist
+            .iter()
+            .filter_map(|h| h.newest_time_s())
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mut disagree = newest - t0 > cfg.max_motion_age_s + cfg.max_clock_skew_s;
+        if let Some(f) = &self.field
+            && f.time_s - t0 > cfg.max_clock_skew_s
+        {
+            disagree = true;
+        }
+        if disagree {
+            fl |= flags::CLOCKS_DISAGREE;
+        }
+        // ages are never negative: a field stamped a little after the newest motion (within the
+        // clocks' skew) is taken as current
+        match self.field.as_ref().map(|f| (t0 - f.time_s).max(0.0)) {
             None => fl |= flags::NO_WAVES,
             Some(a) if a.is_nan() || a > cfg.suppress_wave_age_s => fl |= flags::NO_WAVES | flags::STALE_WAVES,
             Some(a) if a > cfg.max_wave_age_s => fl |= flags::STALE_WAVES,
             _ => {}
         }
-        let can = fl & (flags::NO_WAVES | flags::NO_MOTION | flags::STALE_MOTION) == 0 && t0.is_finite();
+        let can = fl & (flags::NO_WAVES | flags::NO_MOTION | flags::STALE_MOTION | flags::CLOCKS_DISAGREE) == 0
+            && t0.is_finite();
+        if self.forecasting != Some(can) {
+            let why = flags::names(fl).join(", ");
+            match (self.forecasting, can) {
+                (_, true) => tracing::info!("forecasting"),
+                (Some(true), false) => tracing::warn!(flags = %why, "forecasting stopped: status only"),
+                (None, false) => tracing::info!(flags = %why, "waiting for inputs: status only"),
+                _ => {}
+            }
+            self.forecasting = Some(can);
+        }
         let mut job = None;
         if can && self.busy {
             self.counters.overruns += 1;
@@ -362,11 +523,36 @@ impl Engine {
                     motion_time_s: t0,
                     ..ForecastHeader::default()
                 };
-                for (b, p) in self.positions.iter().enumerate() {
-                    let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0);
-                    header.horizon_s[b] = (h.horizon_s - (t0 - f.time_s)).max(0.0);
-                }
                 let waves = f.for_vessel(self.origin_m, self.heading, t0);
+                let (mut total, mut dropped) = (0.0, 0.0);
+                for w in &waves {
+                    let var = 0.5 * w.amplitude_m.norm_sqr();
+                    total += var;
+                    if !self.db.covers(w.omega_rad_s, w.heading_rad) {
+                        dropped += var;
+                    }
+                }
+                self.dropped_wave_share = if total > 0.0 { dropped / total } else { 0.0 };
+                if dropped > 0.0 {
+                    header.flags |= flags::WAVES_DROPPED;
+                }
+                // what the field says about where it was observed decides how far it is trusted
+                let known = match f.region {
+                    _ if f.components.is_empty() => {
+                        header.flags |= flags::NO_WAVE_COMPONENTS;
+                        false
+                    }
+                    crate::waves::field::Region::Everywhere => {
+                        header.flags |= flags::WAVE_REGION_UNKNOWN;
+                        false
+                    }
+                    _ => self.dropped_wave_share <= cfg.max_dropped_wave_share,
+                };
+                for (b, p) in self.positions.iter().enumerate() {
+                    let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0).horizon_s - (t0 - f.time_s).max(0.0);
+                    header.horizon_s[b] = if known && h.is_finite() { h.max(0.0) } else { 0.0 };
+                }
+                fl = header.flags;
                 self.busy = true;
                 job = Some(Job {
                     t0_s: t0,
@@ -378,7 +564,7 @@ impl Engine {
                 });
             }
         }
-        self.state_flags = fl | (self.state_flags & flags::NUMERICAL);
+        self.state_flags = fl | (self.state_flags & (flags::NUMERICAL | flags::CLOCK_STEP));
         job
     }
 
@@ -410,12 +596,12 @@ impl Engine {
             .filter_map(|h| h.newest_time_s())
             .fold(f64::NEG_INFINITY, f64::max);
         let mut s = Status {
-            schema_version: SCHEMA_VERSION,
+            schema_version: crate::ipc::wire::STATUS_SCHEMA_VERSION,
             flags: self.state_flags,
             time_s: if now_data.is_finite() { now_data } else { -1.0 },
             wall_time_s: wall_s,
             wave_age_s: match &self.field {
-                Some(f) if now_data.is_finite() => now_data - f.time_s,
+                Some(f) if now_data.is_finite() => (now_data - f.time_s).max(0.0),
                 _ => -1.0,
             },
             last_forecast_time_s: self.last_forecast_time,
@@ -428,6 +614,11 @@ impl Engine {
             dropped_nonfinite: c.nonfinite,
             dropped_late: c.late,
             dropped_duplicate: c.duplicate,
+            dropped_future: c.future,
+            dropped_past: c.past,
+            dropped_rejected: c.rejected,
+            clock_steps: c.clock_steps,
+            dropped_wave_share: self.dropped_wave_share,
             running: running as u32,
             ..Status::default()
         };
@@ -435,7 +626,7 @@ impl Engine {
             s.motion_age_s[b] = self.arrival[b].map(|a| clock_s - a).unwrap_or(-1.0);
             s.motion_rate_hz[b] = h.rate_hz();
         }
-        self.state_flags &= !flags::NUMERICAL;
+        self.state_flags &= !(flags::NUMERICAL | flags::CLOCK_STEP);
         s
     }
 }

@@ -26,7 +26,20 @@ import iceoryx2 as iox2
 SCHEMA_VERSION = 1
 MAX_VESSELS = 4
 DOFS = ["surge", "sway", "heave", "roll", "pitch", "yaw"]
-FLAGS = ["stale_waves", "stale_motion", "history_short", "numerical_trouble", "no_waves", "history_gap", "no_motion"]
+FLAGS = [
+    "stale_waves",
+    "stale_motion",
+    "history_short",
+    "numerical_trouble",
+    "no_waves",
+    "history_gap",
+    "no_motion",
+    "wave_region_unknown",
+    "no_wave_components",
+    "waves_dropped",
+    "clock_step",
+    "clocks_disagree",
+]
 
 
 class ForecastHeader(ctypes.Structure):

@@ -1,0 +1,319 @@
+//! Faulty but plausible inputs fed through the daemon's own engine (`replay::drive`, as `shipcast
+//! replay` does) (issue 26): each test pins a fault found on an earlier main and says what it did.
+//! The log: three simulated minutes of the one-ship demo (`config/one-ship.toml`), made once.
+
+use crate::util::{repo, scratch_dir, shipcast};
+use shipcast::ipc::Output;
+use shipcast::ipc::wire::{ForecastHeader, Status, flags};
+use shipcast::replay::{self, Record};
+use std::sync::OnceLock;
+
+/// Simulated seconds in the log.
+const LOG_S: f64 = 180.0;
+/// Where in the log the faults are put, s after its start: after the 60 s memory has filled.
+const FAULT_AT_S: f64 = 90.0;
+
+struct Log {
+    cfg: shipcast::service::config::ShipcastConfig,
+    sys: shipcast::hydro::VesselSystem,
+    records: Vec<(f64, Record)>,
+}
+
+fn log() -> &'static Log {
+    static LOG: OnceLock<Log> = OnceLock::new();
+    LOG.get_or_init(|| {
+        let dir = scratch_dir("trust");
+        let text = std::fs::read_to_string(repo("config/one-ship.toml")).unwrap().replace(
+            "file = \"vessels/ship/system.toml\"",
+            &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
+        );
+        let cfg_path = dir.join("shipcast.toml");
+        std::fs::write(&cfg_path, text).unwrap();
+        let path = dir.join("sim.mcap");
+        let (ok, _, err) = shipcast(&[
+            "simulate",
+            "--config",
+            cfg_path.to_str().unwrap(),
+            "--record",
+            path.to_str().unwrap(),
+            "--duration",
+            &LOG_S.to_string(),
+        ]);
+        assert!(ok, "{err}");
+        let cfg = shipcast::service::config::load(&cfg_path).unwrap();
+        let sys = shipcast::files::load_system(&repo("config/vessels/ship/system.toml"))
+            .unwrap()
+            .system;
+        let records = replay::read(&path).unwrap().records;
+        Log { cfg, sys, records }
+    })
+}
+
+/// The log's first time, s.
+fn start(records: &[(f64, Record)]) -> f64 {
+    records[0].0
+}
+
+struct Run {
+    forecasts: Vec<(ForecastHeader, Vec<f64>)>,
+    statuses: Vec<Status>,
+}
+
+fn drive(records: &[(f64, Record)]) -> Run {
+    let l = log();
+    let mut run = Run {
+        forecasts: vec![],
+        statuses: vec![],
+    };
+    replay::drive(
+        &l.cfg,
+        &l.sys,
+        records,
+        |_| {},
+        |o| match o {
+            Output::Forecast(h, v) => run.forecasts.push((h, v)),
+            Output::Status(s) => run.statuses.push(s),
+        },
+    )
+    .unwrap();
+    run
+}
+
+/// Forecasts issued after `after_s` (seconds after the log's start).
+fn after(run: &Run, t0: f64, after_s: f64) -> Vec<&ForecastHeader> {
+    run.forecasts
+        .iter()
+        .map(|(h, _)| h)
+        .filter(|h| h.issue_time_s - t0 > after_s)
+        .collect()
+}
+
+/// The invariants every output keeps, whatever the input: finite values and horizons, a horizon
+/// no longer than the forecast, ages never negative.
+fn invariants(run: &Run) {
+    for (h, v) in &run.forecasts {
+        assert!(v.iter().all(|x| x.is_finite()), "a non-finite forecast value");
+        let len = h.steps as f64 * h.dt_s;
+        for hz in &h.horizon_s[..h.n_vessels as usize] {
+            assert!(hz.is_finite() && *hz >= 0.0, "horizon {hz}");
+            assert!(*hz <= len + 1e-9 || *hz <= 1e4, "horizon {hz} beyond any field");
+        }
+    }
+    for s in &run.statuses {
+        assert!(
+            s.wave_age_s == -1.0 || (s.wave_age_s.is_finite() && s.wave_age_s >= 0.0),
+            "wave age {}",
+            s.wave_age_s
+        );
+        assert!(s.horizon_s.iter().all(|h| h.is_finite()), "{:?}", s.horizon_s);
+    }
+}
+
+fn baseline() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| drive(&log().records))
+}
+
+/// The index of the first record of `kind` at or after `at_s` seconds into the log.
+fn first_after(records: &[(f64, Record)], at_s: f64, waves: bool) -> usize {
+    let t0 = start(records);
+    records
+        .iter()
+        .position(|(t, r)| {
+            *t - t0 >= at_s
+                && matches!(r, Record::Waves(_)) == waves
+                && matches!(r, Record::Waves(_) | Record::Motion(_))
+        })
+        .unwrap()
+}
+
+#[test]
+fn the_unfaulted_log_forecasts_with_finite_trusted_horizons() {
+    let run = baseline();
+    invariants(run);
+    let t0 = start(&log().records);
+    let late = after(run, t0, FAULT_AT_S);
+    assert!(late.len() > 50, "{} forecasts", late.len());
+    assert!(
+        late.iter()
+            .all(|h| h.horizon_s[0] > 10.0 && h.flags & flags::HISTORY_SHORT == 0)
+    );
+}
+
+/// Was: one wave field stamped an hour ahead made every later forecast trusted for its whole length,
+/// and every genuine field after it was ignored as older.
+#[test]
+fn one_wave_field_stamped_an_hour_ahead_is_refused() {
+    let mut records = log().records.clone();
+    let i = first_after(&records, FAULT_AT_S, true);
+    if let Record::Waves(w) = &mut records[i].1 {
+        w.time_s += 3600.0;
+    }
+    let run = drive(&records);
+    invariants(&run);
+    let t0 = start(&records);
+    let late = after(&run, t0, FAULT_AT_S + 10.0);
+    assert!(late.len() > 50);
+    for h in &late {
+        assert!(h.wave_time_s < h.issue_time_s + 1.0, "a forecast used the future field");
+        assert!(h.horizon_s[0] < h.steps as f64 * h.dt_s, "trusted for its whole length");
+    }
+    assert_eq!(run.statuses.last().unwrap().dropped_future, 1);
+}
+
+/// Was: one IMU sample stamped an hour ahead dropped every later genuine sample as late: that vessel
+/// never forecast again until restart.
+#[test]
+fn one_motion_sample_stamped_an_hour_ahead_is_refused_and_forecasts_go_on() {
+    let mut records = log().records.clone();
+    let i = first_after(&records, FAULT_AT_S, false);
+    if let Record::Motion(m) = &mut records[i].1 {
+        m.time_s += 3600.0;
+    }
+    let run = drive(&records);
+    invariants(&run);
+    let t0 = start(&records);
+    let (base, got) = (
+        after(baseline(), t0, FAULT_AT_S).len(),
+        after(&run, t0, FAULT_AT_S).len(),
+    );
+    assert!(
+        got + 2 >= base,
+        "{got} forecasts after the fault against {base} without it"
+    );
+    assert_eq!(run.statuses.last().unwrap().dropped_future, 1);
+}
+
+/// Was: a wave field stamped +inf stopped forecasting until restart, with `wave_age_s = -inf`.
+#[test]
+fn a_wave_field_stamped_infinite_is_refused() {
+    let mut records = log().records.clone();
+    let i = first_after(&records, FAULT_AT_S, true);
+    if let Record::Waves(w) = &mut records[i].1 {
+        w.time_s = f64::INFINITY;
+    }
+    let run = drive(&records);
+    invariants(&run);
+    let t0 = start(&records);
+    assert!(after(&run, t0, FAULT_AT_S + 10.0).len() > 50);
+}
+
+/// Was: a field with radius 0 ("unknown region") or no components was published with an infinite
+/// trusted horizon over a wave-free forecast.
+#[test]
+fn a_field_that_says_nothing_of_where_it_was_observed_is_not_trusted() {
+    for (flag, edit) in [
+        (
+            flags::WAVE_REGION_UNKNOWN,
+            (|w: &mut replay::WavesRecord| w.radius_m = 0.0) as fn(&mut replay::WavesRecord),
+        ),
+        (flags::NO_WAVE_COMPONENTS, |w: &mut replay::WavesRecord| {
+            w.components.clear()
+        }),
+    ] {
+        let mut records = log().records.clone();
+        for (_, r) in records.iter_mut() {
+            if let Record::Waves(w) = r {
+                edit(w);
+            }
+        }
+        let run = drive(&records);
+        invariants(&run);
+        let t0 = start(&records);
+        let late = after(&run, t0, FAULT_AT_S);
+        assert!(!late.is_empty());
+        for h in late {
+            assert!(h.flags & flag != 0, "flags {:?}", flags::names(h.flags));
+            assert_eq!(h.horizon_s[0], 0.0);
+        }
+    }
+}
+
+/// Was: a step of an IMU's clock (GNSS/NTP) left that vessel without forecasts until restart. Now the
+/// source re-synchronizes after `clock_resync_samples` consistent samples; while the motion's clock and
+/// the radar's disagree nothing is forecast; when the host's clock stepped for both, forecasts resume
+/// at once, with the motion history restarting (flagged short).
+#[test]
+fn a_step_of_the_clocks_is_recovered_from_and_a_disagreement_never_forecast() {
+    const STEP_S: f64 = -3600.0;
+    let cfg = &log().cfg;
+    // forecasts resume this soon after a step of every clock, s: the radar's resync samples, one per
+    // scan, then a tick
+    let resume_s = cfg.forecast.clock_resync_samples as f64 * cfg.simulate.radar.period_s + cfg.forecast.period_s;
+    for both in [false, true] {
+        let mut records = log().records.clone();
+        let t0 = start(&records);
+        for (t, r) in records.iter_mut() {
+            match r {
+                Record::Motion(m) if *t - t0 >= FAULT_AT_S => m.time_s += STEP_S,
+                Record::Waves(w) if both && *t - t0 >= FAULT_AT_S => w.time_s += STEP_S,
+                _ => {}
+            }
+        }
+        let run = drive(&records);
+        invariants(&run);
+        let last = run.statuses.last().unwrap();
+        assert_eq!(last.clock_steps, if both { 2 } else { 1 }, "{last:?}");
+        assert!(run.statuses.iter().any(|s| s.flags & flags::CLOCK_STEP != 0));
+        // forecasts after the step are issued on the new clock
+        let later: Vec<&ForecastHeader> = run
+            .forecasts
+            .iter()
+            .map(|(h, _)| h)
+            .filter(|h| h.issue_time_s < t0 + FAULT_AT_S + STEP_S / 2.0)
+            .collect();
+        if both {
+            let first = later.first().expect("no forecast after the step");
+            let resumed_s = first.issue_time_s - (t0 + FAULT_AT_S + STEP_S);
+            eprintln!("forecasts resumed {resumed_s:.1} s after a step of every clock (bound {resume_s:.1} s)");
+            assert!(resumed_s <= resume_s, "{resumed_s}");
+            assert!(first.flags & flags::HISTORY_SHORT != 0);
+            assert!(later.len() > 50);
+        } else {
+            assert!(later.is_empty(), "{} forecasts while the clocks disagree", later.len());
+            assert!(
+                last.flags & flags::CLOCKS_DISAGREE != 0,
+                "{:?}",
+                flags::names(last.flags)
+            );
+        }
+    }
+}
+
+/// Was: samples with a vessel index out of range or an unknown schema version were dropped with no
+/// counter, flag or log line.
+#[test]
+fn refused_samples_are_counted_in_the_status() {
+    let mut records = log().records.clone();
+    let i = first_after(&records, FAULT_AT_S, false);
+    if let Record::Motion(m) = &mut records[i].1 {
+        m.vessel = 7;
+    }
+    let run = drive(&records);
+    assert_eq!(run.statuses.last().unwrap().dropped_rejected, 1);
+}
+
+/// Was: wave components outside the database's frequencies were dropped with nothing in the flags.
+#[test]
+fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_trusted() {
+    let mut records = log().records.clone();
+    for (_, r) in records.iter_mut() {
+        if let Record::Waves(w) = r {
+            // a component above the database's 1.6 rad/s holding as much variance as all the others
+            let var: f64 = w.components.iter().map(|c| 0.5 * (c[2] * c[2] + c[3] * c[3])).sum();
+            let a = (2.0 * var).sqrt();
+            w.components.push([3.0, 0.0, a, 0.0]);
+        }
+    }
+    let run = drive(&records);
+    invariants(&run);
+    let t0 = start(&records);
+    let late = after(&run, t0, FAULT_AT_S);
+    assert!(!late.is_empty());
+    for h in late {
+        assert!(h.flags & flags::WAVES_DROPPED != 0);
+        assert_eq!(h.horizon_s[0], 0.0, "half the sea left out, yet trusted");
+    }
+    let share = run.statuses.last().unwrap().dropped_wave_share;
+    assert!((share - 0.5).abs() < 0.05, "{share}");
+}
