@@ -140,19 +140,26 @@ fn the_unfaulted_log_forecasts_with_finite_trusted_horizons() {
     );
 }
 
+/// The log with one edit at the first motion sample (or wave field) after the fault time, driven.
+fn one_fault(waves: bool, edit: impl FnOnce(&mut Record)) -> (Vec<(f64, Record)>, Run) {
+    let mut records = log().records.clone();
+    let i = first_after(&records, FAULT_AT_S, waves);
+    edit(&mut records[i].1);
+    let run = drive(&records);
+    invariants(&run);
+    (records, run)
+}
+
 /// Was: one wave field stamped an hour ahead made every later forecast trusted for its whole length,
 /// and every genuine field after it was ignored as older.
 #[test]
 fn one_wave_field_stamped_an_hour_ahead_is_refused() {
-    let mut records = log().records.clone();
-    let i = first_after(&records, FAULT_AT_S, true);
-    if let Record::Waves(w) = &mut records[i].1 {
-        w.time_s += 3600.0;
-    }
-    let run = drive(&records);
-    invariants(&run);
-    let t0 = start(&records);
-    let late = after(&run, t0, FAULT_AT_S + 10.0);
+    let (records, run) = one_fault(true, |r| {
+        if let Record::Waves(w) = r {
+            w.time_s += 3600.0;
+        }
+    });
+    let late = after(&run, start(&records), FAULT_AT_S + 10.0);
     assert!(late.len() > 50);
     for h in &late {
         assert!(h.wave_time_s < h.issue_time_s + 1.0, "a forecast used the future field");
@@ -165,13 +172,11 @@ fn one_wave_field_stamped_an_hour_ahead_is_refused() {
 /// never forecast again until restart.
 #[test]
 fn one_motion_sample_stamped_an_hour_ahead_is_refused_and_forecasts_go_on() {
-    let mut records = log().records.clone();
-    let i = first_after(&records, FAULT_AT_S, false);
-    if let Record::Motion(m) = &mut records[i].1 {
-        m.time_s += 3600.0;
-    }
-    let run = drive(&records);
-    invariants(&run);
+    let (records, run) = one_fault(false, |r| {
+        if let Record::Motion(m) = r {
+            m.time_s += 3600.0;
+        }
+    });
     let t0 = start(&records);
     let (base, got) = (
         after(baseline(), t0, FAULT_AT_S).len(),
@@ -187,15 +192,12 @@ fn one_motion_sample_stamped_an_hour_ahead_is_refused_and_forecasts_go_on() {
 /// Was: a wave field stamped +inf stopped forecasting until restart, with `wave_age_s = -inf`.
 #[test]
 fn a_wave_field_stamped_infinite_is_refused() {
-    let mut records = log().records.clone();
-    let i = first_after(&records, FAULT_AT_S, true);
-    if let Record::Waves(w) = &mut records[i].1 {
-        w.time_s = f64::INFINITY;
-    }
-    let run = drive(&records);
-    invariants(&run);
-    let t0 = start(&records);
-    assert!(after(&run, t0, FAULT_AT_S + 10.0).len() > 50);
+    let (records, run) = one_fault(true, |r| {
+        if let Record::Waves(w) = r {
+            w.time_s = f64::INFINITY;
+        }
+    });
+    assert!(after(&run, start(&records), FAULT_AT_S + 10.0).len() > 50);
 }
 
 /// Was: a field with radius 0 ("unknown region") or no components was published with an infinite
@@ -284,12 +286,11 @@ fn a_step_of_the_clocks_is_recovered_from_and_a_disagreement_never_forecast() {
 /// counter, flag or log line.
 #[test]
 fn refused_samples_are_counted_in_the_status() {
-    let mut records = log().records.clone();
-    let i = first_after(&records, FAULT_AT_S, false);
-    if let Record::Motion(m) = &mut records[i].1 {
-        m.vessel = 7;
-    }
-    let run = drive(&records);
+    let (_, run) = one_fault(false, |r| {
+        if let Record::Motion(m) = r {
+            m.vessel = 7;
+        }
+    });
     assert_eq!(run.statuses.last().unwrap().dropped_rejected, 1);
 }
 

@@ -211,6 +211,50 @@ fn log_count(count: u64, what: &str) {
     }
 }
 
+/// A stamp judged by its source's clock, counted and logged: None if refused, else whether the source's
+/// clock stepped (and re-synchronized) with it.
+fn judge(
+    source: &mut clock::SourceClock,
+    c: &mut Counters,
+    what: &str,
+    stamp_s: f64,
+    clock_s: f64,
+    rules: &clock::ClockRules,
+) -> Option<bool> {
+    match source.judge(stamp_s, clock_s, rules) {
+        clock::Stamp::Accepted => Some(false),
+        clock::Stamp::Stepped { step_s } => {
+            c.clock_steps += 1;
+            tracing::warn!(
+                step_s,
+                "{what}: the source's clock stepped: re-synchronized, its history restarts"
+            );
+            Some(true)
+        }
+        clock::Stamp::NonFinite => {
+            c.nonfinite += 1;
+            log_count(c.nonfinite, &format!("{what} with a non-finite stamp refused"));
+            None
+        }
+        clock::Stamp::Future { ahead_s } => {
+            c.future += 1;
+            log_count(
+                c.future,
+                &format!("{what} stamped {ahead_s:.3} s ahead of its clock refused"),
+            );
+            None
+        }
+        clock::Stamp::Past { behind_s } => {
+            c.past += 1;
+            log_count(
+                c.past,
+                &format!("{what} stamped {behind_s:.3} s behind its clock refused"),
+            );
+            None
+        }
+    }
+}
+
 fn power_of_ten(mut n: u64) -> bool {
     while n >= 10 && n.is_multiple_of(10) {
         n /= 10;
@@ -321,40 +365,18 @@ impl Engine {
                     );
                     return;
                 }
-                match self.motion_clock[b].judge(m.time_s, clock_s, &rules) {
-                    clock::Stamp::Accepted => {}
-                    clock::Stamp::NonFinite => {
-                        c.nonfinite += 1;
-                        log_count(
-                            c.nonfinite,
-                            &format!("vessel {b}: motion sample with a non-finite stamp refused"),
-                        );
-                        return;
-                    }
-                    clock::Stamp::Future { ahead_s } => {
-                        c.future += 1;
-                        log_count(
-                            c.future,
-                            &format!("vessel {b}: motion sample stamped {ahead_s:.3} s ahead of its clock refused"),
-                        );
-                        return;
-                    }
-                    clock::Stamp::Past { behind_s } => {
-                        c.past += 1;
-                        log_count(
-                            c.past,
-                            &format!("vessel {b}: motion sample stamped {behind_s:.3} s behind its clock refused"),
-                        );
-                        return;
-                    }
-                    clock::Stamp::Stepped { step_s } => {
-                        c.clock_steps += 1;
+                match judge(
+                    &mut self.motion_clock[b],
+                    c,
+                    &format!("vessel {b}: motion sample"),
+                    m.time_s,
+                    clock_s,
+                    &rules,
+                ) {
+                    None => return,
+                    Some(false) => {}
+                    Some(true) => {
                         self.state_flags |= flags::CLOCK_STEP;
-                        tracing::warn!(
-                            vessel = b,
-                            step_s,
-                            "motion clock stepped: re-synchronized, its history restarts"
-                        );
                         self.hist[b] = History::new(self.keep_s);
                     }
                 }
@@ -383,36 +405,12 @@ impl Engine {
             }
             Input::Waves(f) => {
                 c.wave_fields += 1;
-                let stepped = match self.wave_clock.judge(f.time_s, clock_s, &rules) {
-                    clock::Stamp::Accepted => false,
-                    clock::Stamp::Stepped { step_s } => {
-                        c.clock_steps += 1;
-                        self.state_flags |= flags::CLOCK_STEP;
-                        tracing::warn!(step_s, "radar clock stepped: re-synchronized");
-                        true
-                    }
-                    clock::Stamp::NonFinite => {
-                        c.nonfinite += 1;
-                        log_count(c.nonfinite, "wave field with a non-finite stamp refused");
-                        return;
-                    }
-                    clock::Stamp::Future { ahead_s } => {
-                        c.future += 1;
-                        log_count(
-                            c.future,
-                            &format!("wave field stamped {ahead_s:.3} s ahead of the radar's clock refused"),
-                        );
-                        return;
-                    }
-                    clock::Stamp::Past { behind_s } => {
-                        c.past += 1;
-                        log_count(
-                            c.past,
-                            &format!("wave field stamped {behind_s:.3} s behind the radar's clock refused"),
-                        );
-                        return;
-                    }
+                let Some(stepped) = judge(&mut self.wave_clock, c, "wave field", f.time_s, clock_s, &rules) else {
+                    return;
                 };
+                if stepped {
+                    self.state_flags |= flags::CLOCK_STEP;
+                }
                 let f = f.pruned(self.cfg.wave_variance_kept);
                 if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
                     self.field = Some(f);
