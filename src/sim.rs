@@ -5,7 +5,8 @@
 //!
 //! Frames (DESIGN.md section 1): the earth frame is x east, y north; the vessels keep station (zero
 //! speed) with the system's x axis along `heading_rad` (counterclockwise from east) and the system's
-//! origin at `origin_m`. Times are seconds from the start of the simulation.
+//! origin at `origin_m`. Times are seconds from the start of the simulation (the shell adds the data
+//! clock's start, `simulate.start_unix_s`).
 
 use crate::hydro::VesselSystem;
 use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel};
@@ -148,6 +149,11 @@ impl Simulation {
                 }
             })
             .collect()
+    }
+
+    /// The radar's newest snapshot (elevation, m, on its grid), if any.
+    pub fn last_grid(&self) -> Option<&Grid> {
+        self.grids.last()
     }
 
     /// A radar snapshot at time t; once enough snapshots are in, the processor's wave field (referred

@@ -4,13 +4,20 @@
 use crate::util::{repo, scratch_dir, shipcast};
 use std::path::{Path, PathBuf};
 
+/// The simulated logs' data clock at the start (2025-06-15 UTC): fixed, so logs are reproducible.
+const START_UNIX_S: f64 = 1_750_000_000.0;
+
 /// The README's skill-report config (`config/one-ship.toml`), copied into `dir` with its system path
-/// made absolute.
+/// made absolute and the data clock's start fixed.
 fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(repo("config/one-ship.toml")).unwrap().replace(
-        "file = \"vessels/ship/system.toml\"",
-        &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
-    );
+    let text = std::fs::read_to_string(repo("config/one-ship.toml"))
+        .unwrap()
+        .replace(
+            "file = \"vessels/ship/system.toml\"",
+            &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
+        )
+        .replace("[simulate]\n", &format!("[simulate]\nstart_unix_s = {START_UNIX_S:?}\n"));
+    assert!(text.contains("start_unix_s"));
     assert!(text.contains(&*repo("config/vessels").to_string_lossy()));
     let p = dir.join("shipcast.toml");
     std::fs::write(&p, text).unwrap();
@@ -171,11 +178,34 @@ fn python_lists_the_channels_and_decodes_a_message_of_each() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let channels: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let (meta, channels): (Vec<_>, Vec<_>) = lines.iter().partition(|l| l.get("metadata").is_some());
     let topics: Vec<&str> = channels.iter().map(|c| c["topic"].as_str().unwrap()).collect();
-    assert_eq!(topics, ["/motion", "/waves", "/truth"]);
+    assert_eq!(topics, ["/motion", "/waves", "/truth", "/radar"]);
     assert_eq!(channels[0]["first"]["x"].as_array().unwrap().len(), 6);
     assert!(channels[1]["first"]["radius_m"].as_f64().unwrap() > 0.0);
+    for c in &channels {
+        // a real JSON Schema with field names, and log times on the UNIX clock (ISO dates compare as text)
+        assert_eq!(c["schema_encoding"], "jsonschema", "{c}");
+        let fields: Vec<&str> = c["fields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert!(!fields.is_empty(), "{c}");
+        let first = c["first"].as_object().unwrap();
+        assert!(first.keys().all(|k| fields.contains(&k.as_str())), "{c}");
+        assert!(c["first_log_time"].as_str().unwrap() > "2020-01-01", "{c}");
+    }
+    assert!(channels[0]["fields"].as_array().unwrap().contains(&"time_s".into()));
+    assert_eq!(channels[3]["schema"], "foxglove.Grid");
+    assert_eq!(channels[3]["first"]["column_count"], 128);
+    assert_eq!(meta.len(), 1, "{text}");
+    assert_eq!(meta[0]["metadata"], "shipcast");
+    assert_eq!(meta[0]["vessels"], "[\"carrier\"]");
+    assert_eq!(meta[0]["writer"], "simulate");
+    assert_eq!(meta[0]["shipcast_version"], env!("CARGO_PKG_VERSION"));
 }
 
 #[test]
@@ -210,7 +240,7 @@ fn damaged_logs_keep_what_is_readable_and_newer_schemas_are_refused() {
         let mut w = mcap::WriteOptions::new().create(f).unwrap();
         let sid = w.add_schema("shipcast.Motion", "jsonschema", b"{}").unwrap();
         let mut meta = std::collections::BTreeMap::new();
-        meta.insert("shipcast_schema_version".to_string(), "2".to_string());
+        meta.insert("shipcast_schema_version".to_string(), "3".to_string());
         let ch = w.add_channel(sid, "/motion", "json", &meta).unwrap();
         w.write_to_known_channel(
             &mcap::records::MessageHeader {
@@ -227,16 +257,16 @@ fn damaged_logs_keep_what_is_readable_and_newer_schemas_are_refused() {
     let (ok, _, err) = shipcast(&["replay", newer.to_str().unwrap(), "--config", cfg.to_str().unwrap()]);
     assert!(!ok);
     assert!(
-        err.contains("schema version 2") && err.contains("upgrade shipcast"),
+        err.contains("schema version 3") && err.contains("upgrade shipcast"),
         "{err}"
     );
 }
 
 #[test]
 fn logs_rotate_by_log_time_and_every_message_is_kept() {
-    use shipcast::replay::{MotionRecord, Record, RotatingRecorder, read};
+    use shipcast::replay::{LogInfo, MotionRecord, Record, RotatingRecorder, read};
     let dir = scratch_dir("rotate-time");
-    let mut r = RotatingRecorder::new(&dir, 1000.0, Some(10.0)).unwrap();
+    let mut r = RotatingRecorder::new(&dir, 1000.0, Some(10.0), LogInfo::default()).unwrap();
     for k in 0..350 {
         let t = 0.1 * k as f64;
         let m = MotionRecord {
@@ -305,7 +335,7 @@ fn csv_recordings_import_and_replay_without_code() {
         .collect();
     let mut probe = String::from("time_s,elevation_m,east_m,north_m,towards_deg\n");
     let mut t = fields[0].time_s;
-    while t < 400.0 {
+    while t < START_UNIX_S + 400.0 {
         let f = fields.iter().rev().find(|f| f.time_s <= t).unwrap();
         probe.push_str(&format!("{t:.1},{:.6},400,0,270\n", f.elevation_at([400.0, 0.0], t)));
         t += 0.5;
@@ -431,4 +461,176 @@ fn a_replay_publishes_for_a_console() {
     assert!(forecasts(&got) >= 5, "{} forecasts", forecasts(&got));
     assert!(got.iter().any(|r| matches!(r, Received::Status(s) if s.running == 1)));
     assert!(!motion.is_empty());
+}
+
+/// A replay of the 40 s fixture log takes about a second; a replay that has not ended after this
+/// long is spinning (the faults below ran for ever).
+const REPLAY_DEADLINE: std::time::Duration = std::time::Duration::from_secs(120);
+
+/// Runs `shipcast` as a child process; kills it and fails the test if it has not ended by `deadline`.
+/// Returns (success, stdout, stderr).
+fn shipcast_within(args: &[&str], deadline: std::time::Duration) -> (bool, String, String) {
+    use std::io::Read;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_shipcast"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the shipcast binary runs");
+    // drain the pipes on threads so a chatty child cannot block on a full pipe
+    let mut so = child.stdout.take().unwrap();
+    let mut se = child.stderr.take().unwrap();
+    let out = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = so.read_to_string(&mut s);
+        s
+    });
+    let err = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = se.read_to_string(&mut s);
+        s
+    });
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("shipcast {} did not end within {deadline:?}: killed", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    (status.success(), out.join().unwrap(), err.join().unwrap())
+}
+
+/// The version-1 fixture log and its config (tests/data/replay-v1).
+fn v1_fixture() -> (PathBuf, PathBuf) {
+    (
+        repo("tests/data/replay-v1/shipcast.toml"),
+        repo("tests/data/replay-v1/sim.mcap"),
+    )
+}
+
+/// Offsets of the Chunk records (opcode 0x06) of an MCAP file.
+fn chunk_offsets(bytes: &[u8]) -> Vec<usize> {
+    let mut at = 8; // magic
+    let mut out = vec![];
+    while at + 9 <= bytes.len() {
+        let op = bytes[at];
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        if op == 0x06 {
+            out.push(at);
+        }
+        if op == 0x0f {
+            break; // footer
+        }
+        at += 9 + len;
+    }
+    out
+}
+
+#[test]
+fn a_corrupt_chunk_header_is_read_up_to_the_damage_in_bounded_time() {
+    let dir = scratch_dir("replay-chunk-header");
+    let (cfg, log) = v1_fixture();
+    let mut bytes = std::fs::read(&log).unwrap();
+    let chunks = chunk_offsets(&bytes);
+    assert!(chunks.len() >= 2, "the fixture has {} chunks", chunks.len());
+    // the last chunk's uncompressed size (after opcode, length, start and end times) off by 1000
+    let at = chunks[chunks.len() - 1] + 1 + 8 + 16;
+    let size = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+    bytes[at..at + 8].copy_from_slice(&(size + 1000).to_le_bytes());
+    let bad = dir.join("bad-chunk.mcap");
+    std::fs::write(&bad, &bytes).unwrap();
+    let (ok, _, err) = shipcast_within(
+        &["replay", bad.to_str().unwrap(), "--config", cfg.to_str().unwrap()],
+        REPLAY_DEADLINE,
+    );
+    assert!(ok, "{err}");
+    assert!(err.contains("warning") && err.contains("bad-chunk.mcap"), "{err}");
+    let forecasts: usize = err
+        .split(" forecasts (")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(0);
+    assert!(forecasts > 0, "{err}");
+}
+
+#[test]
+fn a_log_time_gap_replays_in_time_proportional_to_its_messages() {
+    use shipcast::replay::{LogInfo, MotionRecord, Record, Recorder, read};
+    let dir = scratch_dir("replay-gap");
+    let (cfg, log) = v1_fixture();
+    let mut records = read(&log).unwrap().records;
+    // one absurd time: a motion sample in the year 2446 (log time 1.5e19 ns, near the largest an MCAP
+    // log time can hold), a tick per second across the gap: 1.5e10 ticks
+    let far = 1.5e10;
+    records.push((
+        far,
+        Record::Motion(MotionRecord {
+            vessel: 0,
+            time_s: far,
+            x: [0.0; 6],
+            v: [0.0; 6],
+        }),
+    ));
+    let gap = dir.join("gap.mcap");
+    let mut rec = Recorder::create(&gap, &LogInfo::default()).unwrap();
+    for (t, r) in &records {
+        rec.record(*t, r).unwrap();
+    }
+    rec.finish().unwrap();
+    let (ok, _, err) = shipcast_within(
+        &["replay", gap.to_str().unwrap(), "--config", cfg.to_str().unwrap()],
+        REPLAY_DEADLINE,
+    );
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn a_version_1_log_still_replays_to_the_same_forecasts() {
+    use shipcast::replay::{ForecastRecord, Record, read};
+    let dir = scratch_dir("replay-v1");
+    let (cfg, log) = v1_fixture();
+    let out = dir.join("replayed.mcap");
+    let (ok, _, err) = shipcast_within(
+        &[
+            "replay",
+            log.to_str().unwrap(),
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        REPLAY_DEADLINE,
+    );
+    assert!(ok, "{err}");
+    let forecasts = |p: &Path| -> Vec<ForecastRecord> {
+        let r = read(p).unwrap();
+        assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+        r.records
+            .into_iter()
+            .filter_map(|(_, r)| match r {
+                Record::Forecast(f) => Some(f),
+                _ => None,
+            })
+            .collect()
+    };
+    // the forecasts today's shipcast replays from it are those the version-1 shipcast replayed
+    let (was, now) = (forecasts(&repo("tests/data/replay-v1/forecasts.mcap")), forecasts(&out));
+    assert!(was.len() > 20, "{}", was.len());
+    assert_eq!(was.len(), now.len());
+    for (a, b) in was.iter().zip(&now) {
+        assert_eq!(a.issue_time_s.to_bits(), b.issue_time_s.to_bits());
+        assert_eq!(a.flags, b.flags);
+        assert!(
+            a.values.len() == b.values.len() && a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "the forecast at {} differs",
+            a.issue_time_s
+        );
+    }
 }

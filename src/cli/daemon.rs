@@ -160,8 +160,9 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     } else {
         None
     };
-    // the data clock: UNIX seconds at the start, then simulation time
-    let epoch = service::wall_s();
+    // the data clock: UNIX seconds at the start (simulate.start_unix_s, default the wall clock), then
+    // simulation time; published and recorded stamps and log times are on it
+    let epoch = cfg.simulate.start_unix_s.unwrap_or_else(service::wall_s);
     let mut truth_out = match &a.truth {
         Some(p) => {
             let mut f =
@@ -172,12 +173,17 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         None => None,
     };
     let mut recorder = match &a.record {
-        Some(p) => Some(shipcast::replay::Recorder::create(p).map_err(|e| anyhow::anyhow!("{e}"))?),
+        Some(p) => Some(
+            shipcast::replay::Recorder::create(p, &shipcast::replay::LogInfo::of(&cfg, &sys, "simulate"))
+                .map_err(|e| anyhow::anyhow!("{e}"))?,
+        ),
         None => None,
     };
     let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
     let radar_dt = cfg.simulate.radar.period_s;
     let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
+    let grid_every = cfg.simulate.radar.record_grid_every;
+    let mut scans = 0u64;
     let start = Instant::now();
     let speed = cfg.simulate.speed;
     let mut stop_seen = false;
@@ -207,7 +213,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
         } else if let Some(rec) = recorder.as_mut() {
-            use shipcast::replay::{MotionRecord, WavesRecord};
+            use shipcast::replay::{GridRecord, MotionRecord, WavesRecord};
             let e = |e| {
                 anyhow::anyhow!(
                     "{}: {e}",
@@ -215,19 +221,30 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                 )
             };
             if next_radar <= next_imu {
-                if let Some(f) = sim.radar(t) {
-                    rec.write("/waves", t, &WavesRecord::of(&f)).map_err(e)?;
+                let field = sim.radar(t);
+                if grid_every > 0
+                    && scans.is_multiple_of(grid_every as u64)
+                    && let Some(g) = sim.last_grid()
+                {
+                    let grid = GridRecord::elevation(&g.x_m, &g.y_m, &g.values, t + epoch);
+                    rec.write("/radar", t + epoch, &grid).map_err(e)?;
+                }
+                scans += 1;
+                if let Some(mut f) = field {
+                    f.time_s += epoch;
+                    rec.write("/waves", t + epoch, &WavesRecord::of(&f)).map_err(e)?;
                 }
                 next_radar += radar_dt;
                 continue;
             }
+            let stamp = t + epoch;
             for s in sim.imu(t) {
                 rec.write(
                     "/motion",
-                    t,
+                    stamp,
                     &MotionRecord {
                         vessel: s.vessel as u32,
-                        time_s: t,
+                        time_s: stamp,
                         x: s.x,
                         v: s.v,
                     },
@@ -239,10 +256,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                 }
                 rec.write(
                     "/truth",
-                    t,
+                    stamp,
                     &MotionRecord {
                         vessel: s.vessel as u32,
-                        time_s: t,
+                        time_s: stamp,
                         x,
                         v: [0.0; 6],
                     },
@@ -254,7 +271,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
             continue;
         }
         if let Some(f) = truth_out.as_mut() {
-            write!(f, "{:.3}", t + if publisher.is_some() { epoch } else { 0.0 })?;
+            write!(f, "{:.3}", t + epoch)?;
             for i in 0..6 * n_bodies {
                 write!(f, ",{:.6e}", Dof::of_index(i).to_output(sim.true_x(t, i)))?;
             }

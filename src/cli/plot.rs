@@ -303,7 +303,7 @@ impl Figure for ForecastFigure<'_> {
 /// a panel per operation channel over lead times 0 to `span_s`, as `svg` and the PNG beside it.
 pub fn forecast(svg: &Path, issue_time_s: f64, reference: &str, span_s: f64, panels: &[ForecastPanel]) -> Result<()> {
     let fig = ForecastFigure {
-        title: format!("Forecast issued at {issue_time_s:.1} s against the {reference} motion that followed"),
+        title: format!("Forecast issued {issue_time_s:.1} s into the log against the {reference} motion that followed"),
         reference,
         span_s,
         panels,

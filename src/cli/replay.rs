@@ -41,9 +41,9 @@ pub struct ReplayArgs {
     /// with --speed.
     #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "", value_name = "PREFIX")]
     publish: Option<String>,
-    /// With --report: also plot the forecast issued nearest this time (the sensors' clock, as
-    /// forecasts' issue times) against what followed (`forecast-<t>.svg` and `.png`); repeatable. Default: the
-    /// middle forecast of the log.
+    /// With --report: also plot the forecast issued nearest this time, in seconds from the log's first
+    /// motion sample (the sensors' clock), against what followed (`forecast-<t>.svg` and `.png`, t in
+    /// the same seconds); repeatable. Default: the middle forecast of the log.
     #[arg(long, allow_negative_numbers = true)]
     at: Vec<f64>,
 }
@@ -167,7 +167,8 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         data_s / 3600.0 / (secs / 60.0)
     );
     if let Some(p) = &a.out {
-        let mut rec = replay::Recorder::create(p).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let mut rec = replay::Recorder::create(p, &replay::LogInfo::of(&cfg, &sys, "replay"))
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
         for f in &forecasts {
             rec.write("/forecast", f.issue_time_s, f)
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -195,7 +196,9 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
             &measured,
             reference,
         )?;
-        // issue times are on the sensors' clock; default: the middle forecast
+        // issue times are on the sensors' clock (UNIX seconds), --at from its start; default: the
+        // middle forecast
+        let t0 = if d0.is_finite() { d0 } else { t_first };
         let ats = if a.at.is_empty() {
             forecasts
                 .get(forecasts.len() / 2)
@@ -203,15 +206,15 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
                 .into_iter()
                 .collect()
         } else {
-            a.at.clone()
+            a.at.iter().map(|t| t0 + t).collect::<Vec<f64>>()
         };
         for at in ats {
             if let Some(f) = forecasts
                 .iter()
                 .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
             {
-                let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s));
-                forecast_plot(&p, f, &sys, &channels, &measured, reference)?;
+                let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s - t0));
+                forecast_plot(&p, f, t0, &sys, &channels, &measured, reference)?;
                 println!("forecast against actual: {} (and .png)", p.display());
             }
         }
@@ -395,6 +398,7 @@ fn windows_report(
 fn forecast_plot(
     svg: &Path,
     f: &ForecastRecord,
+    log_start_s: f64,
     sys: &shipcast::hydro::VesselSystem,
     channels: &[Channel],
     measured: &[Vec<(f64, f64)>],
@@ -439,7 +443,7 @@ fn forecast_plot(
             }
         })
         .collect();
-    plot::forecast(svg, f.issue_time_s, reference, span, &panels)
+    plot::forecast(svg, f.issue_time_s - log_start_s, reference, span, &panels)
 }
 
 /// Skill of every vessel DOF against lead time, against the measured motion in the log.
@@ -602,7 +606,8 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         records.extend(f.into_iter().map(|w| (w.time_s, Record::Waves(w))));
     }
     records.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut rec = replay::Recorder::create(&a.out).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut rec = replay::Recorder::create(&a.out, &replay::LogInfo::of(&cfg, &sys, "import"))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     for (t, r) in &records {
         rec.record(*t, r).map_err(|e| anyhow::anyhow!("{e}"))?;
     }

@@ -186,6 +186,8 @@ pub struct SimulateConfig {
     /// Model error: the true linear damping is this factor times the model's.
     pub damping_factor: f64,
     pub ramp_s: f64,
+    /// The data clock at the start, UNIX seconds (None: the wall clock at the start).
+    pub start_unix_s: Option<f64>,
     pub sea: SeaConfig,
     pub radar: RadarConfig,
     pub imu: ImuConfig,
@@ -199,6 +201,7 @@ impl Default for SimulateConfig {
             seed: 1,
             damping_factor: 1.0,
             ramp_s: 30.0,
+            start_unix_s: None,
             sea: SeaConfig::default(),
             radar: RadarConfig::default(),
             imu: ImuConfig::default(),
@@ -244,6 +247,8 @@ pub struct RadarConfig {
     pub period_s: f64,
     pub noise_m: f64,
     pub snapshots: usize,
+    /// A recording (`simulate --record`) writes one snapshot in this many to `/radar` (0: none).
+    pub record_grid_every: u32,
 }
 
 impl Default for RadarConfig {
@@ -254,6 +259,7 @@ impl Default for RadarConfig {
             period_s: 2.0,
             noise_m: 0.05,
             snapshots: 3,
+            record_grid_every: 15,
         }
     }
 }
@@ -575,6 +581,9 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     pos("simulate.radar.radius_m", s.radar.radius_m)?;
     pos("simulate.radar.period_s", s.radar.period_s)?;
     pos("simulate.imu.rate_hz", s.imu.rate_hz)?;
+    if let Some(t) = s.start_unix_s {
+        pos("simulate.start_unix_s", t)?;
+    }
     if !(8..=1024).contains(&s.radar.cells) {
         return Err((
             "simulate.radar.cells".into(),

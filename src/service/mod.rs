@@ -684,14 +684,22 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let mut sigterm = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
     let start = Instant::now();
-    let clock = || start.elapsed().as_secs_f64();
+    // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
+    // log times are this clock, so they line up with the ship's other logs)
+    let clock_anchor_s = wall_s();
+    let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
     // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
     // decision); a write error is logged and ends the recording, never the daemon
     let mut recorder = if cfg.record.dir.is_empty() {
         None
     } else {
         let dir = cfg.dir.join(&cfg.record.dir);
-        match crate::replay::RotatingRecorder::new(&dir, cfg.record.rotate_mb, cfg.record.rotate_s) {
+        match crate::replay::RotatingRecorder::new(
+            &dir,
+            cfg.record.rotate_mb,
+            cfg.record.rotate_s,
+            crate::replay::LogInfo::of(&cfg, &sys, "daemon"),
+        ) {
             Ok(r) => Some(r),
             Err(e) => {
                 tracing::error!("recording disabled: {e}");
