@@ -16,7 +16,10 @@ fn config(dir: &Path) -> PathBuf {
             "file = \"vessels/ship/system.toml\"",
             &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
         )
-        .replace("[simulate]\n", &format!("[simulate]\nstart_unix_s = {START_UNIX_S:?}\n"));
+        .replace(
+            "[simulate]\n",
+            &format!("[simulate]\nstart_unix_s = {START_UNIX_S:?}\n"),
+        );
     assert!(text.contains("start_unix_s"));
     assert!(text.contains(&*repo("config/vessels").to_string_lossy()));
     let p = dir.join("shipcast.toml");
@@ -445,7 +448,7 @@ fn a_replay_publishes_for_a_console() {
     let _replay = shipcast::process::Interrupting(
         std::process::Command::new(env!("CARGO_BIN_EXE_shipcast"))
             .args(["replay", log.to_str().unwrap(), "--config", cfg.to_str().unwrap()])
-            .args(["--speed", "10", "--publish", &prefix])
+            .args(["--speed", "10", &format!("--publish={prefix}")])
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::null())
             .spawn()
