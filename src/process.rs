@@ -23,9 +23,9 @@ impl Drop for Interrupting {
         if let Ok(Some(_)) = self.0.try_wait() {
             return;
         }
-        let _ = std::process::Command::new("kill")
-            .args(["-INT", &self.0.id().to_string()])
-            .status();
+        if let Ok(pid) = i32::try_from(self.0.id()) {
+            let _ = nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid), nix::sys::signal::Signal::SIGINT);
+        }
         let t = Instant::now();
         while t.elapsed() < GRACE {
             if let Ok(Some(_)) = self.0.try_wait() {

@@ -252,6 +252,25 @@ fn demo_piped_prints_lines_that_say_how_long_the_warm_up_lasts() {
     );
 }
 
+/// Was: SIGHUP killed the daemon without a final status (the last one still said `running = true`).
+#[test]
+fn sighup_stops_the_daemon_cleanly_with_a_last_status() {
+    let dir = crate::util::scratch_dir("daemon-sighup");
+    let cfg = config(&dir, "sighup", "");
+    let mut d = daemon(&cfg);
+    let pid = nix::unistd::Pid::from_raw(d.0.id() as i32);
+    let hup = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_secs(3));
+        nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGHUP).unwrap();
+    });
+    let msgs = watch(&cfg, 15.0, |m| m["kind"] == "status" && m["running"] == false);
+    hup.join().unwrap();
+    let status = d.0.wait().unwrap();
+    assert!(status.success(), "{status:?}");
+    let last = msgs.iter().rev().find(|m| m["kind"] == "status").expect("a status");
+    assert_eq!(last["running"], false, "{last}");
+}
+
 #[test]
 fn a_config_with_a_wrong_key_or_type_is_refused() {
     let dir = crate::util::scratch_dir("daemon-badcfg");

@@ -642,7 +642,8 @@ pub fn watchdog_fits(period_s: f64, watchdog_s: Option<f64>) -> Result<(), Strin
     }
 }
 
-/// Runs the daemon until SIGINT/SIGTERM. Ends with an error (a non-zero exit: systemd restarts it) if
+/// Runs the daemon until SIGINT, SIGTERM or SIGHUP (each a clean stop: a last status with
+/// `running = 0`, exit 0). Ends with an error (a non-zero exit: systemd restarts it) if
 /// the compute thread dies.
 pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) -> Result<(), Error> {
     let mut watchdog_usec = 0u64;
@@ -683,6 +684,9 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let mut sigterm = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+    // SIGHUP (a closed terminal or SSH session): a clean stop with a final status, as SIGTERM; the
+    // configuration is read at start only, so a restart is how it is reloaded
+    let mut sighup = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup())?;
     let start = Instant::now();
     // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
     // log times are this clock, so they line up with the ship's other logs)
@@ -720,6 +724,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
         tokio::select! {
             _ = tokio::signal::ctrl_c() => { tracing::info!("SIGINT: stopping"); break; }
             _ = sigterm.recv() => { tracing::info!("SIGTERM: stopping"); break; }
+            _ = sighup.recv() => { tracing::info!("SIGHUP: stopping (restart shipcast to reload its configuration)"); break; }
             msg = in_rx.recv() => {
                 let Some(msg) = msg else { break };
                 let t = clock();
