@@ -498,7 +498,7 @@ mod tests {
         forecast(&svg, 300.0, "truth", 120.0, &panels).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         for s in [
-            "Forecast issued at 300.0 s against the truth motion",
+            "Forecast issued 300.0 s into the log against the truth motion",
             "lead time (s)",
             "carrier.heave (m)",
             "carrier.roll (deg)",
