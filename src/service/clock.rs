@@ -10,7 +10,9 @@
 //! Rules ([`ClockRules`], from `[forecast]` in the config):
 //! - a stamp that is not finite is refused;
 //! - a stamp more than `max_clock_skew_s` ahead of the reference is refused as from the future (a clock
-//!   glitch must not make every later genuine sample look late);
+//!   glitch must not make every later genuine sample look late); a source whose clock may run faster
+//!   than the engine's (a simulator at `simulate.speed`) is allowed `max_rate - 1` more seconds ahead
+//!   per second since its last accepted sample;
 //! - a stamp more than `max_clock_lag_s` behind it is refused as from the past;
 //! - `clock_resync_samples` consecutive refused samples that agree with each other (within the skew) are
 //!   a step of the source's clock: the source re-synchronizes to them ([`Stamp::Stepped`]), and the
@@ -25,6 +27,8 @@ pub struct ClockRules {
     pub max_lag_s: f64,
     /// Consecutive consistent refused samples that re-synchronize the source.
     pub resync_samples: u32,
+    /// The fastest a source's clock may run against the engine's (source seconds per second, >= 1).
+    pub max_rate: f64,
 }
 
 /// How fast the reference offset may fall without a step, s per s: 1000 ppm, far beyond a drifting
@@ -57,8 +61,8 @@ pub enum Stamp {
 pub struct SourceClock {
     /// Reference offset (stamp - engine clock) and the engine time it was last moved, s.
     reference: Option<(f64, f64)>,
-    /// Refused samples in a row that agree: their offset and count.
-    candidate: Option<(f64, u32)>,
+    /// Refused samples in a row that agree: the last one's offset and engine time, and their count.
+    candidate: Option<(f64, f64, u32)>,
 }
 
 impl SourceClock {
@@ -72,8 +76,10 @@ impl SourceClock {
             self.reference = Some((offset, clock_s));
             return Stamp::Accepted;
         };
-        let floor = reference - DRIFT_S_PER_S * (clock_s - since).max(0.0);
-        let verdict = if offset > reference + rules.max_skew_s {
+        let elapsed_s = (clock_s - since).max(0.0);
+        let floor = reference - DRIFT_S_PER_S * elapsed_s;
+        let fast_s = (rules.max_rate - 1.0).max(0.0);
+        let verdict = if offset > reference + rules.max_skew_s + fast_s * elapsed_s {
             Stamp::Future {
                 ahead_s: offset - reference,
             }
@@ -87,7 +93,7 @@ impl SourceClock {
             return Stamp::Accepted;
         };
         let count = match self.candidate {
-            Some((c, n)) if (offset - c).abs() <= rules.max_skew_s => n + 1,
+            Some((c, at, n)) if (offset - c).abs() <= rules.max_skew_s + fast_s * (clock_s - at).max(0.0) => n + 1,
             _ => 1,
         };
         if count >= rules.resync_samples.max(1) {
@@ -97,7 +103,7 @@ impl SourceClock {
                 step_s: offset - reference,
             };
         }
-        self.candidate = Some((offset, count));
+        self.candidate = Some((offset, clock_s, count));
         verdict
     }
 
@@ -115,6 +121,7 @@ mod tests {
         max_skew_s: 1.0,
         max_lag_s: 30.0,
         resync_samples: 5,
+        max_rate: 1.0,
     };
 
     /// A source at 10 Hz whose clock reads 1.7e9 s at engine time 0, with `f` applied to each stamp.
@@ -170,6 +177,25 @@ mod tests {
         assert_eq!(c.offset_s(), None);
         assert_eq!(c.judge(10.0, 0.0, &RULES), Stamp::Accepted);
         assert_eq!(c.offset_s(), Some(10.0));
+    }
+
+    /// A simulator at 4x: its fields every 2 s of its clock arrive every 0.5 s, each 1.5 s further
+    /// ahead of the engine's clock than the last (more than the skew).
+    #[test]
+    fn a_source_running_faster_within_max_rate_is_accepted_and_its_glitch_refused() {
+        let fast = ClockRules { max_rate: 4.0, ..RULES };
+        let mut c = SourceClock::default();
+        for k in 0..100 {
+            let t = k as f64 * 0.5;
+            assert_eq!(c.judge(1.7e9 + 4.0 * t, t, &fast), Stamp::Accepted, "{k}");
+        }
+        assert!(matches!(
+            c.judge(1.7e9 + 4.0 * 50.0 + 3600.0, 50.0, &fast),
+            Stamp::Future { .. }
+        ));
+        let mut slow = SourceClock::default();
+        assert_eq!(slow.judge(1.7e9, 0.0, &RULES), Stamp::Accepted);
+        assert!(matches!(slow.judge(1.7e9 + 2.0, 0.5, &RULES), Stamp::Future { .. }));
     }
 
     #[test]

@@ -110,6 +110,9 @@ pub struct ForecastConfig {
     /// This many refused samples in a row that agree are a step of the source's clock: it
     /// re-synchronizes to them (its history restarts).
     pub clock_resync_samples: u32,
+    /// The fastest a source's clock may run against the daemon's, data s per s (default:
+    /// `simulate.speed`, at least 1: live sensors run at 1; this config's simulator at its speed).
+    pub max_clock_rate: Option<f64>,
     /// A forecast whose wave field lost more than this share of its variance (components outside the
     /// database's frequencies or headings) is not trusted (trusted horizon 0), 0..1.
     pub max_dropped_wave_share: f64,
@@ -132,6 +135,7 @@ impl Default for ForecastConfig {
             max_clock_skew_s: 1.0,
             max_clock_lag_s: 30.0,
             clock_resync_samples: 5,
+            max_clock_rate: None,
             max_dropped_wave_share: 0.1,
         }
     }
@@ -520,6 +524,14 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     }
     pos("forecast.max_clock_skew_s", f.max_clock_skew_s)?;
     pos("forecast.max_clock_lag_s", f.max_clock_lag_s)?;
+    if let Some(r) = f.max_clock_rate
+        && !(r.is_finite() && (1.0..=1000.0).contains(&r))
+    {
+        return Err((
+            "forecast.max_clock_rate".into(),
+            format!("must be in [1, 1000], found {r}"),
+        ));
+    }
     if !(1..=1000).contains(&f.clock_resync_samples) {
         return Err((
             "forecast.clock_resync_samples".into(),

@@ -326,6 +326,7 @@ impl Engine {
                 max_skew_s: cfg.forecast.max_clock_skew_s,
                 max_lag_s: cfg.forecast.max_clock_lag_s,
                 resync_samples: cfg.forecast.clock_resync_samples,
+                max_rate: cfg.forecast.max_clock_rate.unwrap_or(cfg.simulate.speed).max(1.0),
             },
             keep_s,
             db: model.db.clone(),
