@@ -52,25 +52,29 @@ pub fn load_system(path: &Path) -> Result<Loaded, Error> {
         g: spec.g_m_s2,
         ulen: spec.ulen_m,
     };
+    let bounds = wamit::EntryBounds::from_masses(
+        spec.rho_kg_m3,
+        &spec.bodies.iter().map(|b| b.mass[(0, 0)]).collect::<Vec<_>>(),
+    );
     let mut files = vec![path.to_path_buf()];
     let p1 = with_ext("1");
-    let rad = wamit::read_radiation(open(&p1)?, &p1.display().to_string(), n, s)?;
+    let rad = wamit::read_radiation_bounded(open(&p1)?, &p1.display().to_string(), n, s, &bounds)?;
     files.push(p1);
     let p3 = if with_ext("3").exists() || !with_ext("2").exists() {
         with_ext("3")
     } else {
         with_ext("2")
     };
-    let exc = wamit::read_excitation(open(&p3)?, &p3.display().to_string(), n, s)?;
+    let exc = wamit::read_excitation_bounded(open(&p3)?, &p3.display().to_string(), n, s, &bounds)?;
     files.push(p3.clone());
     let phst = with_ext("hst");
-    let hst = wamit::read_hydrostatics(open(&phst)?, &phst.display().to_string(), n, s)?;
+    let hst = wamit::read_hydrostatics_bounded(open(&phst)?, &phst.display().to_string(), n, s, &bounds)?;
     files.push(phst);
     let mut notes = vec![];
     let (pfk, psc) = (with_ext("3fk"), with_ext("3sc"));
     if pfk.exists() && psc.exists() {
-        let fk = wamit::read_excitation(open(&pfk)?, &pfk.display().to_string(), n, s)?;
-        let sc = wamit::read_excitation(open(&psc)?, &psc.display().to_string(), n, s)?;
+        let fk = wamit::read_excitation_bounded(open(&pfk)?, &pfk.display().to_string(), n, s, &bounds)?;
+        let sc = wamit::read_excitation_bounded(open(&psc)?, &psc.display().to_string(), n, s, &bounds)?;
         notes.push(match wamit::sum_mismatch(&fk, &sc, &exc) {
             Some(e) => format!(
                 "Froude-Krylov + scattering ({}, {}) against the total: largest difference {:.3e} of the largest |X|",

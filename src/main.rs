@@ -210,6 +210,19 @@ impl Omegas {
     }
 }
 
+/// `rao`'s model options, checked as they are read ([`RomOptions::validate`]); the error names the flag.
+fn flag_checked(opts: RomOptions) -> Result<RomOptions> {
+    opts.validate().map_err(|e| {
+        let flag = match e.field {
+            "dt_s" => "--dt",
+            "speed_m_s" => "--speed",
+            other => other,
+        };
+        anyhow::anyhow!("{flag}: {}", e.msg)
+    })?;
+    Ok(opts)
+}
+
 /// Logs to stderr: `RUST_LOG` if set, else `level`; human-readable or JSON lines.
 fn init_logging(level: &str, json: bool) {
     // iceoryx2 logs through tracing; its warnings (e.g. "no config file, defaults used") are noise here
@@ -933,7 +946,7 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 radiation: args.radiation.into(),
                 ..RomOptions::default()
             };
-            let model = TimeModel::new(sys, opts).with_context(context)?;
+            let model = TimeModel::new(sys, flag_checked(opts)?).with_context(context)?;
             floor::implied_table(&model, &omegas, &headings_rad).with_context(context)?
         }
         Method::Time => {
@@ -944,7 +957,7 @@ fn rao(args: &RaoArgs) -> Result<()> {
                 speed_m_s: args.speed,
                 ..RomOptions::default()
             };
-            let model = TimeModel::new(sys, opts).with_context(context)?;
+            let model = TimeModel::new(sys, flag_checked(opts)?).with_context(context)?;
             let mut table = vec![];
             for &h in &headings_deg {
                 let r = time_domain_rao(&model, h.to_radians(), &omegas, RegularOptions::default())

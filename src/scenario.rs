@@ -219,16 +219,18 @@ impl Scenario {
                 ));
             }
         };
+        let opts = RomOptions {
+            dt_s: raw.dt_s,
+            radiation,
+            speed_m_s: raw.speed_m_s,
+            ..RomOptions::default()
+        };
+        opts.validate().map_err(|e| bad(e.field, e.msg))?;
         Ok(Scenario {
             system: path.parent().unwrap_or(Path::new(".")).join(raw.system),
             horizon_s: raw.horizon_s,
             history_s: raw.history_s,
-            opts: RomOptions {
-                dt_s: raw.dt_s,
-                radiation,
-                speed_m_s: raw.speed_m_s,
-                ..RomOptions::default()
-            },
+            opts,
             waves,
             radar_radius_m: raw.radar_radius_m,
         })

@@ -230,3 +230,259 @@ fn tank_that_capsizes_the_ship() {
         &["tank[0]", "exceeds the roll restoring"],
     );
 }
+
+/// A database line replaced: `db check` refuses it within `timeout_s` (a hang is a failure too).
+fn expect_error_within(dir: &PathBuf, timeout_s: u64, want: &[&str]) {
+    use std::process::{Command, Stdio};
+    let sys = dir.join("system.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shipcast"))
+        .args(["db", "check", sys.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if t0.elapsed().as_secs() > timeout_s {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("`db check` still running after {timeout_s} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    assert!(!status.success(), "expected failure");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    for w in want {
+        assert!(err.contains(w), "stderr lacks `{w}`:\n{err}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn added_mass_of_1e300_hangs_in_an_svd() {
+    let d = scratch_copy();
+    replace_line(&d.join("ship.1"), 123, "8.3775804e+01   3   3 1.0e+300 5.2570544e+03");
+    expect_error_within(&d, 60, &["ship.1:123:", "Abar", "1e300"]);
+}
+
+#[test]
+fn excitation_of_1e30_is_beyond_physical_bounds() {
+    let d = scratch_copy();
+    replace_line(
+        &d.join("ship.3"),
+        3,
+        "1.2566371e+02 0.0000000e+00   3 1.0e+30 0.0 1.0e+30 0.0",
+    );
+    expect_error_within(&d, 60, &["ship.3:3:", "Re X"]);
+}
+
+#[test]
+fn restoring_of_1e40_is_beyond_physical_bounds() {
+    let d = scratch_copy();
+    let hst = std::fs::read_to_string(d.join("ship.hst")).unwrap();
+    let n = hst
+        .lines()
+        .position(|l| l.split_whitespace().take(2).eq(["3", "3"]))
+        .unwrap()
+        + 1;
+    replace_line(&d.join("ship.hst"), n, "  3   3 1.0e+40");
+    expect_error_within(&d, 60, &[&format!("ship.hst:{n}:"), "Cbar"]);
+}
+
+#[test]
+fn radiation_file_cut_at_a_line_end_passes_db_check() {
+    let d = scratch_copy();
+    // the last frequency keeps 18 of its 36 pairs
+    edit(&d.join("ship.1"), |t| {
+        let lines: Vec<&str> = t.lines().collect();
+        lines[..lines.len() - 18].join("\n") + "\n"
+    });
+    expect_error(&d, &["ship.1", "period 3.9269908 s", "has no entry for modes 4 1"]);
+}
+
+#[test]
+fn excitation_file_cut_at_a_line_end_passes_db_check() {
+    let d = scratch_copy();
+    // the last heading of the last frequency keeps 2 of its 6 modes
+    edit(&d.join("ship.3"), |t| {
+        let lines: Vec<&str> = t.lines().collect();
+        lines[..lines.len() - 4].join("\n") + "\n"
+    });
+    expect_error(&d, &["ship.3", "period 3.9269908 s", "has no entry for mode 3"]);
+}
+
+/// The shipped `config/shipcast.toml` with `key = value` set in `[section]`, loaded (no environment).
+fn config_with(section: &str, key: &str, value: &str) -> Result<(), String> {
+    config_with_env(section, key, value, &[])
+}
+
+fn config_with_env(section: &str, key: &str, value: &str, env: &[(&str, &str)]) -> Result<(), String> {
+    let text = std::fs::read_to_string(repo("config/shipcast.toml")).unwrap();
+    let mut out = vec![];
+    let mut inside = false;
+    let mut done = false;
+    for l in text.lines() {
+        let t = l.trim_start();
+        if t.starts_with('[') && !t.starts_with("[[") {
+            inside = t.starts_with(&format!("[{section}]"));
+            out.push(l.to_string());
+            if inside && !text.contains(&format!("\n{key} =")) && !text.contains(&format!("\n# {key} =")) {
+                out.push(format!("{key} = {value}"));
+                done = true;
+            }
+            continue;
+        }
+        let stripped = t.trim_start_matches("# ");
+        if inside && !done && (stripped.starts_with(&format!("{key} ")) || stripped.starts_with(&format!("{key}="))) {
+            out.push(format!("{key} = {value}"));
+            done = true;
+        } else {
+            out.push(l.to_string());
+        }
+    }
+    assert!(done, "no [{section}] in config/shipcast.toml");
+    let dir = std::env::temp_dir().join(format!(
+        "shipcast-bad-config-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::SeqCst)
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("shipcast.toml");
+    std::fs::write(&path, out.join("\n")).unwrap();
+    let env: Vec<(String, String)> = env.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    let r = shipcast::service::config::load_with_env(&path, &env)
+        .map(|_| ())
+        .map_err(|e| e.to_string());
+    let _ = std::fs::remove_dir_all(&dir);
+    r
+}
+
+fn refused(r: Result<(), String>, want: &[&str]) {
+    let err = r.expect_err("the configuration was accepted");
+    for w in want {
+        assert!(err.contains(w), "`{err}` lacks `{w}`");
+    }
+}
+
+#[test]
+fn negative_memory_s_runs_with_no_radiation_memory() {
+    refused(
+        config_with("forecast", "memory_s", "-5.0"),
+        &["forecast.memory_s", "-5"],
+    );
+}
+
+#[test]
+fn memory_s_of_1e9_aborts_on_allocation() {
+    refused(
+        config_with("forecast", "memory_s", "1e9"),
+        &["forecast.memory_s", "1000000000"],
+    );
+}
+
+#[test]
+fn nan_history_margin_grows_the_history_without_bound() {
+    refused(
+        config_with("forecast", "history_margin_s", "nan"),
+        &["forecast.history_margin_s", "NaN"],
+    );
+}
+
+#[test]
+fn period_s_of_1e20_panics() {
+    refused(
+        config_with("forecast", "period_s", "1e20"),
+        &["forecast.period_s", "[0.05, 60]"],
+    );
+}
+
+#[test]
+fn period_s_of_1e_12_panics() {
+    refused(
+        config_with("forecast", "period_s", "1e-12"),
+        &["forecast.period_s", "[0.05, 60]"],
+    );
+}
+
+#[test]
+fn horizon_s_true_is_taken_as_one_second() {
+    refused(
+        config_with("forecast", "horizon_s", "true"),
+        &["forecast.horizon_s", "boolean"],
+    );
+    // and from the environment
+    refused(
+        config_with_env(
+            "forecast",
+            "horizon_s",
+            "120.0",
+            &[("SHIPCAST_FORECAST__HORIZON_S", "true")],
+        ),
+        &["SHIPCAST_FORECAST__HORIZON_S", "forecast.horizon_s"],
+    );
+}
+
+#[test]
+fn log_level_loud_is_accepted_and_nothing_logged() {
+    refused(config_with("log", "level", "\"loud\""), &["log.level", "loud"]);
+    // a directive is a level
+    config_with("log", "level", "\"shipcast=debug,warn\"").unwrap();
+}
+
+#[test]
+fn invalid_service_prefix_is_reported_without_the_key() {
+    refused(
+        config_with("ipc", "service_prefix", "\"iox2://shipcast\""),
+        &["ipc.service_prefix", "iox2://shipcast"],
+    );
+}
+
+#[test]
+fn imu_rate_of_1e9_hz_is_accepted() {
+    refused(
+        config_with("simulate.imu", "rate_hz", "1e9"),
+        &["simulate.imu.rate_hz", "1000"],
+    );
+}
+
+#[test]
+fn sea_components_of_1e9_are_accepted() {
+    refused(
+        config_with("simulate.sea", "components", "1000000000"),
+        &["simulate.sea.components", "10000"],
+    );
+}
+
+#[test]
+fn rao_time_step_of_1e_7_aborts_on_allocation() {
+    let (ok, _, err) = shipcast(&[
+        "rao",
+        "config/vessels/ship/system.toml",
+        "--method",
+        "time",
+        "--dt",
+        "1e-7",
+    ]);
+    assert!(!ok);
+    assert!(!err.contains("memory allocation"), "{err}");
+    assert!(
+        err.contains("--dt") && err.contains("1e-7") && err.contains("0.001"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_shipped_configurations_are_within_bounds() {
+    for f in [
+        "config/shipcast.toml",
+        "config/one-ship.toml",
+        "tests/data/replay-v1/shipcast.toml",
+    ] {
+        shipcast::service::config::load_with_env(&repo(f), &[]).unwrap_or_else(|e| panic!("{e}"));
+    }
+}

@@ -45,6 +45,83 @@ pub const TAIL_END_FACTOR: f64 = 20.0;
 /// Ratio between successive tail nodes.
 pub const TAIL_NODE_RATIO: f64 = 1.1;
 
+/// Shortest time step of a sampled K(t) and of the solvers that sample it, s: wave periods are seconds,
+/// a millisecond resolves them a thousandfold; below it the taps only cost memory.
+pub const MIN_DT_S: f64 = 1e-3;
+/// Longest time step, s: Newmark's step must sample a 3 s wave period several times.
+pub const MAX_DT_S: f64 = 1.0;
+/// Longest radiation memory, s: K(t) of a floating body decays within minutes; an hour is more than
+/// any database's frequency spacing resolves (pi / dw at dw = 0.001 rad/s).
+pub const MAX_MEMORY_S: f64 = 3600.0;
+/// Most samples of K(t) (memory / dt + 1): the convolution kernel of a 12-DOF system with this many
+/// taps is 70 MB, and each forecast step reads all of them.
+pub const MAX_TAPS: usize = 60_000;
+
+/// A time grid of K(t) (step and memory) outside [`MIN_DT_S`]..[`MAX_DT_S`], (0, [`MAX_MEMORY_S`]] or
+/// [`MAX_TAPS`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GridError {
+    Dt(f64),
+    Memory(f64),
+    Taps { dt_s: f64, memory_s: f64 },
+}
+
+impl GridError {
+    /// The option at fault: `dt_s` or `memory_s`.
+    pub fn field(&self) -> &'static str {
+        match self {
+            GridError::Dt(_) => "dt_s",
+            GridError::Memory(_) | GridError::Taps { .. } => "memory_s",
+        }
+    }
+}
+
+impl std::fmt::Display for GridError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GridError::Dt(v) => write!(f, "the time step must be in [{MIN_DT_S}, {MAX_DT_S}] s, found {v:?}"),
+            GridError::Memory(v) => write!(f, "the radiation memory must be in (0, {MAX_MEMORY_S}] s, found {v:?}"),
+            GridError::Taps { dt_s, memory_s } => write!(
+                f,
+                "a {memory_s:?} s radiation memory at a {dt_s:?} s step is {:.0} taps, more than {MAX_TAPS}: \
+                 lengthen the step or shorten the memory",
+                (memory_s / dt_s).round() + 1.0
+            ),
+        }
+    }
+}
+
+impl std::error::Error for GridError {}
+
+/// Checks a time step alone.
+pub fn check_dt(dt_s: f64) -> Result<(), GridError> {
+    if (MIN_DT_S..=MAX_DT_S).contains(&dt_s) {
+        Ok(())
+    } else {
+        Err(GridError::Dt(dt_s))
+    }
+}
+
+/// Checks a memory length alone.
+pub fn check_memory(memory_s: f64) -> Result<(), GridError> {
+    if memory_s > 0.0 && memory_s <= MAX_MEMORY_S {
+        Ok(())
+    } else {
+        Err(GridError::Memory(memory_s))
+    }
+}
+
+/// Checks a time grid of K(t): the step, the memory and the number of samples they make. Every sampled
+/// K (the IRF, the convolution's taps, the state-space fit's grid) is sized by a grid that passed it.
+pub fn check_grid(dt_s: f64, memory_s: f64) -> Result<(), GridError> {
+    check_dt(dt_s)?;
+    check_memory(memory_s)?;
+    if (memory_s / dt_s).round() + 1.0 > MAX_TAPS as f64 {
+        return Err(GridError::Taps { dt_s, memory_s });
+    }
+    Ok(())
+}
+
 /// Weights w_k such that int f(x) trig(s x) dx over [x_0, x_last] = sum_k w_k f(x_k) for f linear between
 /// the nodes x_k (ascending). `sine` selects sin instead of cos. Closed form per segment; 4-point
 /// Gauss-Legendre where s h is small and the closed form would cancel.

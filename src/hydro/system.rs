@@ -223,9 +223,7 @@ impl SystemSpec {
         let mut irf = IrfOptions::default();
         if let Some(f) = raw.irf {
             if let Some(dt) = f.dt_s {
-                if !(dt.is_finite() && dt > 0.0 && dt <= 1.0) {
-                    return Err(key("irf.dt_s", format!("must be in (0, 1] s, found {dt}")));
-                }
+                super::radiation::check_dt(dt).map_err(|e| key("irf.dt_s", e.to_string()))?;
                 irf.dt_s = dt;
             }
             if let Some(d) = f.duration_s {
@@ -484,6 +482,15 @@ impl VesselSystem {
         file: &str,
     ) -> Result<VesselSystem> {
         let mut db = HydroDb::new(rad, exc, restoring, file)?;
+        let memory_s = spec
+            .irf
+            .duration_s
+            .unwrap_or_else(|| super::radiation::default_duration_s(&db));
+        super::radiation::check_grid(spec.irf.dt_s, memory_s).map_err(|e| Error::Key {
+            file: file.into(),
+            key: "irf".into(),
+            msg: e.to_string(),
+        })?;
         let mut warnings = vec![];
         if !spec.hydrodynamic_coupling {
             db.decouple();

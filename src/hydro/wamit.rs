@@ -13,6 +13,19 @@
 //! Files written by WAMIT start with a one-line text header; files written by other tools often have
 //! none: a first line whose first field is not a number is taken as the header.
 //! Rows may come in any order; frequencies are returned sorted ascending.
+//!
+//! Completeness: WAMIT omits a pair (I, J) or a mode I only when it is zero at every frequency, so every
+//! positive period of a `.1` file lists the same pairs (the union over its positive periods; PER = -1 / 0
+//! rows may list another set), and every (period, heading) of a `.3` file the same modes. A period or
+//! heading missing some is an error naming the file, the period and the first missing pair or mode (a
+//! file cut short).
+//!
+//! Physical bounds ([`EntryBounds`], from the system file's masses): WAMIT's own scaling with the body's
+//! length l = (m / rho)^(1/3) (m its mass; the geometric mean of the two bodies' for a coupling entry) in
+//! place of ULEN makes every coefficient of a floating body of order one: |A_ij| <= F rho l^k,
+//! |B_ij| <= F rho l^k max(w, sqrt(g / l)), |C_ij| <= F rho g l^k (k as above), |X_i| <= F rho g l^m, with
+//! F = [`ENTRY_FACTOR`]. An entry beyond is an error naming the file and line: such a value is a corrupt
+//! file, not a hull, and it would stall the solvers (an SVD of a matrix spanning 300 decades).
 
 use super::{Error, Result};
 use nalgebra::DMatrix;
@@ -45,6 +58,51 @@ impl Scaling {
     }
     fn m_exc(i0: usize) -> i32 {
         2 + Self::is_rot(i0) as i32
+    }
+}
+
+/// How far beyond the scale of its body a database entry may be (see the module doc): a 100 m square
+/// barge of 0.1 m draft has pitch restoring about 1e3 rho g l^4, the most extreme hull in sight.
+pub const ENTRY_FACTOR: f64 = 1.0e4;
+
+/// The physical bounds of database entries: each mode's body length l = (m / rho)^(1/3), m.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EntryBounds {
+    length_m: Vec<f64>,
+}
+
+impl EntryBounds {
+    /// No bounds (every finite value is accepted).
+    pub fn none() -> EntryBounds {
+        EntryBounds::default()
+    }
+
+    /// The bounds of bodies of these masses (kg), in the system file's order (6 modes each).
+    pub fn from_masses(rho: f64, masses_kg: &[f64]) -> EntryBounds {
+        EntryBounds {
+            length_m: masses_kg
+                .iter()
+                .flat_map(|m| std::iter::repeat_n((m / rho).cbrt(), 6))
+                .collect(),
+        }
+    }
+
+    /// The length scale of a pair of modes, when bounded.
+    fn length(&self, i0: usize, j0: usize) -> Option<f64> {
+        let (a, b) = (self.length_m.get(i0)?, self.length_m.get(j0)?);
+        let l = (a * b).sqrt();
+        (l.is_finite() && l > 0.0).then_some(l)
+    }
+}
+
+/// The error of an entry beyond its bound.
+fn beyond(file: &str, line: usize, what: &str, raw: f64, value: f64, bound: f64, l: f64) -> Error {
+    Error::Parse {
+        file: file.into(),
+        line,
+        msg: format!(
+            "{what} = {raw:?} makes {value:.3e}, beyond the physical bound {bound:.3e} ({ENTRY_FACTOR:e} times the scale of a body of length (m / rho)^(1/3) = {l:.3} m): a corrupt entry?"
+        ),
     }
 }
 
@@ -184,13 +242,24 @@ fn per_to_omega(file: &str, line: usize, per: f64) -> Result<f64> {
     }
 }
 
-/// Rows of one period of a `.1` file: omega, A, B, which (i, j) were seen.
-type RadiationRows = (f64, DMatrix<f64>, DMatrix<f64>, Vec<bool>);
+/// Rows of one period of a `.1` file: omega, A, B, which (i, j) were seen, first line.
+type RadiationRows = (f64, DMatrix<f64>, DMatrix<f64>, Vec<bool>, usize);
 /// Rows of one period of a `.3` file: omega, first line, heading bits -> (heading, per-mode values).
 type ExcitationRows = (f64, usize, BTreeMap<u64, (f64, Vec<Option<Complex64>>)>);
 
 /// Reads a `.1` file for `n_modes` = 6N modes.
 pub fn read_radiation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scaling) -> Result<Radiation> {
+    read_radiation_bounded(reader, file, n_modes, s, &EntryBounds::none())
+}
+
+/// [`read_radiation`] with every entry within `bounds`.
+pub fn read_radiation_bounded<R: BufRead>(
+    reader: R,
+    file: &str,
+    n_modes: usize,
+    s: Scaling,
+    bounds: &EntryBounds,
+) -> Result<Radiation> {
     // key: period bits (the same period prints identically on every row of a frequency)
     let mut by_per: BTreeMap<u64, RadiationRows> = BTreeMap::new();
     for (line, f) in data_lines(reader, file)? {
@@ -219,6 +288,7 @@ pub fn read_radiation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scal
                 DMatrix::zeros(n_modes, n_modes),
                 DMatrix::zeros(n_modes, n_modes),
                 vec![false; n_modes * n_modes],
+                line,
             )
         });
         if entry.3[i * n_modes + j] {
@@ -234,6 +304,41 @@ pub fn read_radiation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scal
         if finite {
             entry.2[(i, j)] = s.rho * omega * s.ulen.powi(k) * bbar;
         }
+        if let Some(l) = bounds.length(i, j) {
+            let a_max = ENTRY_FACTOR * s.rho * l.powi(k);
+            if entry.1[(i, j)].abs() > a_max {
+                return Err(beyond(file, line, "column 4 (Abar)", abar, entry.1[(i, j)], a_max, l));
+            }
+            let b_max = a_max * omega.max((s.g / l).sqrt());
+            if finite && entry.2[(i, j)].abs() > b_max {
+                return Err(beyond(file, line, "column 5 (Bbar)", bbar, entry.2[(i, j)], b_max, l));
+            }
+        }
+    }
+    // every positive period lists the pairs the others list
+    let mut union = vec![false; n_modes * n_modes];
+    for (omega, _, _, seen, _) in by_per.values() {
+        if omega.is_finite() && *omega > 0.0 {
+            union.iter_mut().zip(seen).for_each(|(u, s)| *u |= *s);
+        }
+    }
+    let mut periods: Vec<(&u64, &RadiationRows)> = by_per.iter().collect();
+    periods.sort_by_key(|(_, r)| r.4);
+    for (per, (omega, _, _, seen, first)) in periods {
+        if !(omega.is_finite() && *omega > 0.0) {
+            continue;
+        }
+        if let Some(p) = (0..n_modes * n_modes).find(|&p| union[p] && !seen[p]) {
+            return Err(Error::Invalid {
+                file: file.into(),
+                msg: format!(
+                    "period {} s (first at line {first}) has no entry for modes {} {}, which other periods have: is the file cut short?",
+                    f64::from_bits(*per),
+                    p / n_modes + 1,
+                    p % n_modes + 1
+                ),
+            });
+        }
     }
     let mut rad = Radiation {
         omega_rad_s: vec![],
@@ -244,7 +349,7 @@ pub fn read_radiation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scal
     };
     let mut rows: Vec<_> = by_per.into_values().collect();
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (omega, a, b, _) in rows {
+    for (omega, a, b, _, _) in rows {
         if omega == 0.0 {
             rad.added_mass_zero = Some(a);
         } else if omega.is_infinite() {
@@ -266,6 +371,17 @@ pub fn read_radiation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scal
 
 /// Reads a `.3`-type file (`.3`, `.2`, `.3fk`, `.3sc`) for `n_modes` modes.
 pub fn read_excitation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scaling) -> Result<Excitation> {
+    read_excitation_bounded(reader, file, n_modes, s, &EntryBounds::none())
+}
+
+/// [`read_excitation`] with every entry within `bounds`.
+pub fn read_excitation_bounded<R: BufRead>(
+    reader: R,
+    file: &str,
+    n_modes: usize,
+    s: Scaling,
+    bounds: &EntryBounds,
+) -> Result<Excitation> {
     // period bits -> heading bits -> values
     let mut by_per: BTreeMap<u64, ExcitationRows> = BTreeMap::new();
     for (line, f) in data_lines(reader, file)? {
@@ -300,7 +416,43 @@ pub fn read_excitation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Sca
                 msg: format!("duplicate entry for period {per} s, heading {beta} deg, mode {}", i + 1),
             });
         }
-        h.1[i] = Some(Complex64::new(re, im) * scale);
+        let x = Complex64::new(re, im) * scale;
+        if let Some(l) = bounds.length(i, i) {
+            let x_max = ENTRY_FACTOR * s.rho * s.g * l.powi(Scaling::m_exc(i));
+            if x.norm() > x_max {
+                let raw = if re.abs() >= im.abs() { re } else { im };
+                let what = if re.abs() >= im.abs() {
+                    "column 6 (Re X)"
+                } else {
+                    "column 7 (Im X)"
+                };
+                return Err(beyond(file, line, what, raw, x.norm(), x_max, l));
+            }
+        }
+        h.1[i] = Some(x);
+    }
+    // every (period, heading) lists the modes the others list
+    let mut union = vec![false; n_modes];
+    for (_, _, hmap) in by_per.values() {
+        for (_, vals) in hmap.values() {
+            union.iter_mut().zip(vals).for_each(|(u, v)| *u |= v.is_some());
+        }
+    }
+    let mut periods: Vec<(&u64, &ExcitationRows)> = by_per.iter().collect();
+    periods.sort_by_key(|(_, r)| r.1);
+    for (per, (_, first, hmap)) in periods {
+        for (beta, vals) in hmap.values() {
+            if let Some(m) = (0..n_modes).find(|&m| union[m] && vals[m].is_none()) {
+                return Err(Error::Invalid {
+                    file: file.into(),
+                    msg: format!(
+                        "period {} s (first at line {first}), heading {beta} deg has no entry for mode {}, which other periods and headings have: is the file cut short?",
+                        f64::from_bits(*per),
+                        m + 1
+                    ),
+                });
+            }
+        }
     }
     let mut pers: Vec<_> = by_per.into_values().collect();
     pers.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -340,6 +492,17 @@ pub fn read_excitation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Sca
 
 /// Reads a `.hst` file: the linear restoring matrix (N/m, N, N m/rad ...).
 pub fn read_hydrostatics<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scaling) -> Result<DMatrix<f64>> {
+    read_hydrostatics_bounded(reader, file, n_modes, s, &EntryBounds::none())
+}
+
+/// [`read_hydrostatics`] with every entry within `bounds`.
+pub fn read_hydrostatics_bounded<R: BufRead>(
+    reader: R,
+    file: &str,
+    n_modes: usize,
+    s: Scaling,
+    bounds: &EntryBounds,
+) -> Result<DMatrix<f64>> {
     let mut c = DMatrix::zeros(n_modes, n_modes);
     let mut seen = vec![false; n_modes * n_modes];
     for (line, f) in data_lines(reader, file)? {
@@ -356,6 +519,12 @@ pub fn read_hydrostatics<R: BufRead>(reader: R, file: &str, n_modes: usize, s: S
         }
         seen[i * n_modes + j] = true;
         c[(i, j)] = s.rho * s.g * s.ulen.powi(Scaling::k_hst(i, j)) * cbar;
+        if let Some(l) = bounds.length(i, j) {
+            let c_max = ENTRY_FACTOR * s.rho * s.g * l.powi(Scaling::k_hst(i, j));
+            if c[(i, j)].abs() > c_max {
+                return Err(beyond(file, line, "column 3 (Cbar)", cbar, c[(i, j)], c_max, l));
+            }
+        }
     }
     Ok(c)
 }
@@ -392,6 +561,8 @@ mod tests {
     fn radiation_scaling_order_and_limits() {
         let text = " WAMIT header line\n\
             6.0 3 3 2.0 4.0\n\
+            6.0 4 4 1.0 1.0\n\
+            6.0 3 5 1.0 0.5\n\
             -1.0 3 3 5.0\n\
             0.0 3 3 1.0\n\
             12.0 3 3 3.0 1.0\n\
@@ -413,7 +584,8 @@ mod tests {
     #[test]
     fn excitation_scaling_and_headings() {
         let text = "10.0 0.0 3 1 0 1.0 0.5\n10.0 90.0 3 1 0 2.0 0.0\n10.0 0.0 4 1 0 0.0 1.0\n\
-                    5.0 90.0 3 1 0 1.0 0.0\n5.0 0.0 3 1 0 1.0 0.0\n";
+                    10.0 90.0 4 0 0 0.0 0.0\n5.0 90.0 3 1 0 1.0 0.0\n5.0 0.0 3 1 0 1.0 0.0\n\
+                    5.0 90.0 4 1 0 1.0 0.0\n5.0 0.0 4 1 0 1.0 0.0\n";
         let x = read_excitation(text.as_bytes(), "t.3", 6, S).unwrap();
         assert_eq!(x.heading_deg, vec![0.0, 90.0]);
         assert_eq!(x.omega_rad_s.len(), 2);
@@ -453,6 +625,42 @@ mod tests {
         assert!(e.to_string().contains("no data lines"), "{e}");
         let e = read_excitation("-2.0 0 1 1 0 1 0\n".as_bytes(), "t.3", 6, S).unwrap_err();
         assert!(e.to_string().contains("positive period"), "{e}");
+    }
+
+    #[test]
+    fn a_period_missing_pairs_is_an_error() {
+        let text = "6.0 3 3 1.0 1.0\n6.0 4 4 1.0 1.0\n12.0 3 3 1.0 1.0\n-1.0 3 3 1.0\n";
+        let e = read_radiation(text.as_bytes(), "t.1", 6, S).unwrap_err().to_string();
+        assert!(
+            e.contains("period 12 s (first at line 3) has no entry for modes 4 4"),
+            "{e}"
+        );
+        let text = "10.0 0.0 3 1 0 1.0 0.5\n10.0 0.0 4 1 0 1.0 0.5\n5.0 0.0 3 1 0 1.0 0.0\n";
+        let e = read_excitation(text.as_bytes(), "t.3", 6, S).unwrap_err().to_string();
+        assert!(
+            e.contains("period 5 s (first at line 3), heading 0 deg has no entry for mode 4"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn entries_beyond_the_body_scale_name_file_and_line() {
+        // a 1000 t body: l = 10 m at rho = 1000
+        let b = EntryBounds::from_masses(1000.0, &[1.0e6]);
+        let ok = "6.0 3 3 1.0 1.0\n";
+        read_radiation_bounded(ok.as_bytes(), "t.1", 6, S, &b).unwrap();
+        let e = read_radiation_bounded("6.0 3 3 1.0 1.0\n12.0 3 3 1e300 1.0\n".as_bytes(), "t.1", 6, S, &b)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.1:2: column 4 (Abar) = 1e300"), "{e}");
+        let e = read_excitation_bounded("10.0 0.0 3 1 0 1e30 0.0\n".as_bytes(), "t.3", 6, S, &b)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.3:1: column 6 (Re X)"), "{e}");
+        let e = read_hydrostatics_bounded("3 3 1e40\n".as_bytes(), "t.hst", 6, S, &b)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.hst:1: column 3 (Cbar)"), "{e}");
     }
 
     #[test]

@@ -16,6 +16,10 @@ use std::sync::Arc;
 /// bound keeps the forecast's buffers (steps x states) sized by input within reason.
 pub const MAX_FORECAST_LENGTH_S: f64 = 3600.0;
 
+/// Most steps of one forecast (horizon / dt): an hour at 0.01 s; the forecast of a 24-state system
+/// that long is 70 MB.
+pub const MAX_FORECAST_STEPS: usize = 360_000;
+
 /// What a forecast needs, for the active DOFs of the model (in `model.active` order).
 #[derive(Debug, Clone, Copy)]
 pub struct ForecastRequest<'a> {
@@ -177,6 +181,12 @@ impl Forecaster {
             )));
         }
         let steps = (req.horizon_s / dt).round() as usize;
+        if steps > MAX_FORECAST_STEPS {
+            return Err(Error::Input(format!(
+                "forecast length {} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}",
+                req.horizon_s
+            )));
+        }
         self.wave_force(model, req.waves, steps, req.ramp_s)?;
         // the known radiation part: the convolution's only (the modal states carry their own past)
         self.known.clear();

@@ -42,7 +42,7 @@ pub mod stepper;
 
 pub use forecast::{Forecast, ForecastRequest, Forecaster};
 pub use memory::Memory;
-pub use model::{RadiationMethod, RomOptions, TimeModel};
+pub use model::{OptionError, RadiationMethod, RomOptions, TimeModel};
 
 /// Errors of the time-domain model.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -59,6 +59,8 @@ pub enum Error {
     Input(String),
     #[error(transparent)]
     Hydro(#[from] crate::hydro::Error),
+    #[error(transparent)]
+    Option(#[from] model::OptionError),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -54,6 +54,60 @@ impl Default for RomOptions {
     }
 }
 
+/// Largest |forward speed|, m/s: 50 knots, beyond any ship the zero-speed database stands for.
+pub const MAX_SPEED_M_S: f64 = 25.0;
+
+/// An option of [`RomOptions`] out of range: the field and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field}: {msg}")]
+pub struct OptionError {
+    /// `dt_s`, `memory_s`, `beta`, `speed_m_s` or `ss_tolerance`.
+    pub field: &'static str,
+    pub msg: String,
+}
+
+impl RomOptions {
+    /// The one check of the options, for every caller (the configuration, the CLI, scenarios and
+    /// [`TimeModel::new`]): the step in [`radiation::MIN_DT_S`]..[`radiation::MAX_DT_S`], the memory (when
+    /// given) in (0, [`radiation::MAX_MEMORY_S`]] and at most [`radiation::MAX_TAPS`] steps long, beta in
+    /// (0, 1/2], |speed| at most [`MAX_SPEED_M_S`], the fit tolerance in (0, 1).
+    pub fn validate(&self) -> std::result::Result<(), OptionError> {
+        let grid = |e: radiation::GridError| OptionError {
+            field: e.field(),
+            msg: e.to_string(),
+        };
+        radiation::check_dt(self.dt_s).map_err(grid)?;
+        if let Some(m) = self.memory_s {
+            radiation::check_grid(self.dt_s, m).map_err(grid)?;
+        }
+        if !(self.beta > 0.0 && self.beta <= 0.5) {
+            return Err(OptionError {
+                field: "beta",
+                msg: format!("Newmark beta must be in (0, 0.5], found {:?}", self.beta),
+            });
+        }
+        if !(self.speed_m_s.is_finite() && self.speed_m_s.abs() <= MAX_SPEED_M_S) {
+            return Err(OptionError {
+                field: "speed_m_s",
+                msg: format!(
+                    "the forward speed must be in [-{MAX_SPEED_M_S}, {MAX_SPEED_M_S}] m/s, found {:?}",
+                    self.speed_m_s
+                ),
+            });
+        }
+        if !(self.ss_tolerance > 0.0 && self.ss_tolerance < 1.0) {
+            return Err(OptionError {
+                field: "ss_tolerance",
+                msg: format!(
+                    "the state-space fit tolerance must be in (0, 1), found {:?}",
+                    self.ss_tolerance
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// The radiation memory of a model, ready for stepping.
 #[derive(Debug, Clone)]
 pub enum Kernel {
@@ -126,15 +180,7 @@ pub struct TimeModel {
 
 impl TimeModel {
     pub fn new(sys: &VesselSystem, opts: RomOptions) -> Result<TimeModel> {
-        if !(opts.dt_s.is_finite() && opts.dt_s > 0.0 && opts.dt_s <= 1.0) {
-            return Err(Error::Input(format!("time step {} s: must be in (0, 1] s", opts.dt_s)));
-        }
-        if !(opts.beta > 0.0 && opts.beta <= 0.5) {
-            return Err(Error::Input(format!("Newmark beta {}: must be in (0, 0.5]", opts.beta)));
-        }
-        if !opts.speed_m_s.is_finite() {
-            return Err(Error::Input("forward speed must be finite".into()));
-        }
+        opts.validate()?;
         let active = sys.active_states();
         let nh = sys.active_indices().len();
         if nh == 0 {
@@ -156,6 +202,15 @@ impl TimeModel {
         // solver's step (measured on the pair: refitted at each step, its floor was 1.9 % of peak off
         // the frequency domain at dt = 0.05 s and 3.3 % at 0.025 s, lighter yaw in beam seas at 0.05 rad/s)
         let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
+        // the grids K is sampled on: the solver's (convolution) and the system file's (state-space fit)
+        let grid_dt = match opts.radiation {
+            RadiationMethod::StateSpace => sys.spec.irf.dt_s,
+            _ => dt,
+        };
+        radiation::check_grid(grid_dt, memory_s).map_err(|e| OptionError {
+            field: e.field(),
+            msg: e.to_string(),
+        })?;
         let RadiationMemory { irf: irf_all, tail, .. } = match opts.radiation {
             RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
             _ => radiation_memory(sys, dt, memory_s),

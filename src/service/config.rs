@@ -465,6 +465,31 @@ pub fn load_with_env(path: &Path, env: &[(String, String)]) -> Result<ShipcastCo
         file: file.clone(),
         msg,
     })?;
+    // the `config` crate coerces types (a boolean where a number is expected is 0 or 1): the file
+    // again with the TOML types as written, and no boolean in a variable for a numeric key
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Read {
+        file: file.clone(),
+        msg: e.to_string(),
+    })?;
+    if let Err(e) = toml::from_str::<ShipcastConfig>(&text) {
+        let (key, line) = toml_key_at(&text, e.span().map_or(0, |s| s.start));
+        return Err(Error::Key {
+            file: format!("{file}:{line}"),
+            key,
+            msg: e.message().to_string(),
+        });
+    }
+    for (k, v) in &vars {
+        let key = k[ENV_PREFIX.len()..].to_ascii_lowercase().replace("__", ".");
+        let word = v.trim().to_ascii_lowercase();
+        if is_numeric_key(&key) && ["true", "false", "yes", "no", "on", "off"].contains(&word.as_str()) {
+            return Err(Error::Key {
+                file: format!("environment variable {k}={v:?}"),
+                key,
+                msg: format!("expected a number, found the boolean `{v}`"),
+            });
+        }
+    }
     if !vars.is_empty() {
         cfg = build(&vars).map_err(|msg| {
             // name the variable: the first that fails on its own, else all of them
@@ -500,57 +525,288 @@ pub fn load(path: &Path) -> Result<ShipcastConfig, Error> {
     load_with_env(path, &env)
 }
 
-fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
-    let pos = |k: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
+/// A numeric key's accepted range: a finite number from `min` (excluded when `open`) to `max`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    pub key: &'static str,
+    pub min: f64,
+    pub open: bool,
+    pub max: f64,
+    pub unit: &'static str,
+}
+
+const fn closed(key: &'static str, min: f64, max: f64, unit: &'static str) -> Bound {
+    Bound {
+        key,
+        min,
+        open: false,
+        max,
+        unit,
+    }
+}
+
+const fn positive(key: &'static str, max: f64, unit: &'static str) -> Bound {
+    Bound {
+        key,
+        min: 0.0,
+        open: true,
+        max,
+        unit,
+    }
+}
+
+impl Bound {
+    pub fn contains(&self, v: f64) -> bool {
+        v.is_finite() && (v > self.min || (!self.open && v == self.min)) && v <= self.max
+    }
+
+    /// `[min, max] unit` or `(min, max] unit`.
+    pub fn range(&self) -> String {
+        let unit = if self.unit.is_empty() {
+            String::new()
         } else {
-            Err((k.to_string(), format!("must be a positive number, found {v}")))
-        }
-    };
+            format!(" {}", self.unit)
+        };
+        format!("{}{}, {}]{unit}", if self.open { "(" } else { "[" }, self.min, self.max)
+    }
+}
+
+/// One day, s.
+const DAY_S: f64 = 86_400.0;
+
+/// Every numeric key but `forecast.dt_s` and `forecast.memory_s` (checked by
+/// [`crate::rom::RomOptions::validate`], the same check as the CLI's) and `simulate.seed` (any u64), with
+/// why its range is what it is. `config/shipcast.toml` repeats each range beside its key.
+pub const BOUNDS: &[Bound] = &[
+    // half the earth's circumference: any place on it
+    closed("site.origin_east_m", -2.0e7, 2.0e7, "m"),
+    closed("site.origin_north_m", -2.0e7, 2.0e7, "m"),
+    // a compass angle, one turn either way
+    closed("site.heading_deg", -360.0, 360.0, "deg"),
+    // 20 forecasts a second at most (the tick, the IPC and the compute thread); a minute at least
+    closed("forecast.period_s", 0.05, 60.0, "s"),
+    // a forecast's buffers are steps x states: rom::forecast::MAX_FORECAST_LENGTH_S
+    positive("forecast.horizon_s", crate::rom::forecast::MAX_FORECAST_LENGTH_S, "s"),
+    // an hour-old sea is no sea: and the ages are compared with the data clock, not sized
+    positive("forecast.max_wave_age_s", 3600.0, "s"),
+    positive("forecast.suppress_wave_age_s", 3600.0, "s"),
+    positive("forecast.max_motion_age_s", 3600.0, "s"),
+    // a bridged gap is a straight line through the motion: longer than a minute, it is invented
+    positive("forecast.max_gap_s", 60.0, "s"),
+    // samples kept beyond the memory: sizes the history (rate x time per vessel)
+    closed("forecast.history_margin_s", 0.0, 3600.0, "s"),
+    closed("forecast.wave_variance_kept", 1e-6, 1.0, ""),
+    // clock offsets between sources and the daemon: stamps an hour off are not a skew but a wrong clock
+    positive("forecast.max_clock_skew_s", 3600.0, "s"),
+    positive("forecast.max_clock_lag_s", 3600.0, "s"),
+    // refused samples in a row before a clock step is believed: a few seconds of motion at 1000 Hz
+    closed("forecast.clock_resync_samples", 1.0, 1000.0, ""),
+    // how much faster than the daemon's a source's clock may run: a simulator at its speed
+    closed("forecast.max_clock_rate", 1.0, 1000.0, ""),
+    closed("forecast.max_dropped_wave_share", 0.0, 1.0, ""),
+    // a terabyte of messages per file at most
+    positive("record.rotate_mb", 1.0e6, "MB"),
+    positive("record.rotate_s", 30.0 * DAY_S, "s"),
+    // the simulation's truth is kept whole: a week at 10 Hz is about 6 million samples per DOF
+    positive("simulate.duration_s", 7.0 * DAY_S, "s"),
+    positive("simulate.speed", 1000.0, ""),
+    positive("simulate.damping_factor", 100.0, ""),
+    closed("simulate.ramp_s", 0.0, 3600.0, "s"),
+    // UNIX time from 1970 to the year 2286 (f64 seconds keep microseconds there)
+    positive("simulate.start_unix_s", 1.0e10, "s"),
+    // the highest wave ever measured is about 30 m
+    positive("simulate.sea.hs_m", 30.0, "m"),
+    closed("simulate.sea.tp_s", 1.0, 30.0, "s"),
+    // JONSWAP's peak enhancement: 1 (Pierson-Moskowitz) to 10, beyond any fitted sea
+    closed("simulate.sea.gamma", 1.0, 10.0, ""),
+    closed("simulate.sea.towards_deg", -360.0, 360.0, "deg"),
+    positive("simulate.sea.spreading_s", 100.0, ""),
+    // each component is a sinusoid in every force evaluation and on the wire
+    closed("simulate.sea.components", 1.0, 10_000.0, ""),
+    positive("simulate.sea.omega_min_rad_s", 10.0, "rad/s"),
+    positive("simulate.sea.omega_max_rad_s", 10.0, "rad/s"),
+    positive("simulate.radar.radius_m", 20_000.0, "m"),
+    // cells x cells grid per snapshot, FFT-inverted
+    closed("simulate.radar.cells", 8.0, 1024.0, ""),
+    closed("simulate.radar.period_s", 0.1, 60.0, "s"),
+    closed("simulate.radar.noise_m", 0.0, 10.0, "m"),
+    closed("simulate.radar.snapshots", 1.0, 64.0, ""),
+    // 0: no grid recorded; a recorded grid is cells x cells floats
+    closed("simulate.radar.record_grid_every", 0.0, 1.0e6, ""),
+    // a motion sample per IMU tick goes through the IPC and the history
+    positive("simulate.imu.rate_hz", 1000.0, "Hz"),
+    closed("simulate.imu.noise_m", 0.0, 10.0, "m"),
+    closed("simulate.imu.noise_rad", 0.0, 1.0, "rad"),
+    closed("simulate.imu.bias_m", -10.0, 10.0, "m"),
+    closed("simulate.imu.bias_rad", -1.0, 1.0, "rad"),
+    positive("operation.duration_s", DAY_S, "s"),
+    // m, or deg for rotations: beyond this every motion is inside
+    positive("operation.channels.limit", 1.0e4, "m or deg"),
+    positive("console.history_s", 3600.0, "s"),
+];
+
+/// The bound of a key.
+pub fn bound(key: &str) -> Option<&'static Bound> {
+    BOUNDS.iter().find(|b| b.key == key)
+}
+
+/// Every numeric key of the table with its value (`None`: not set), as (bound key, key as named).
+fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
     let f = &c.forecast;
-    pos("forecast.period_s", f.period_s)?;
-    pos("forecast.horizon_s", f.horizon_s)?;
-    pos("forecast.dt_s", f.dt_s)?;
-    pos("forecast.max_wave_age_s", f.max_wave_age_s)?;
-    pos("forecast.suppress_wave_age_s", f.suppress_wave_age_s)?;
-    pos("forecast.max_motion_age_s", f.max_motion_age_s)?;
-    pos("forecast.max_gap_s", f.max_gap_s)?;
-    if !(f.wave_variance_kept > 0.0 && f.wave_variance_kept <= 1.0) {
-        return Err((
-            "forecast.wave_variance_kept".into(),
-            format!("must be in (0, 1], found {}", f.wave_variance_kept),
+    let s = &c.simulate;
+    let one = |k: &'static str, v: f64| (k, k.to_string(), Some(v));
+    let mut out = vec![
+        one("site.origin_east_m", c.site.origin_east_m),
+        one("site.origin_north_m", c.site.origin_north_m),
+        one("site.heading_deg", c.site.heading_deg),
+        one("forecast.period_s", f.period_s),
+        one("forecast.horizon_s", f.horizon_s),
+        one("forecast.max_wave_age_s", f.max_wave_age_s),
+        one("forecast.suppress_wave_age_s", f.suppress_wave_age_s),
+        one("forecast.max_motion_age_s", f.max_motion_age_s),
+        one("forecast.max_gap_s", f.max_gap_s),
+        one("forecast.history_margin_s", f.history_margin_s),
+        one("forecast.wave_variance_kept", f.wave_variance_kept),
+        one("forecast.max_clock_skew_s", f.max_clock_skew_s),
+        one("forecast.max_clock_lag_s", f.max_clock_lag_s),
+        one("forecast.clock_resync_samples", f.clock_resync_samples as f64),
+        ("forecast.max_clock_rate", "forecast.max_clock_rate".to_string(), f.max_clock_rate),
+        one("forecast.max_dropped_wave_share", f.max_dropped_wave_share),
+        one("record.rotate_mb", c.record.rotate_mb),
+        ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
+        one("simulate.duration_s", s.duration_s),
+        one("simulate.speed", s.speed),
+        one("simulate.damping_factor", s.damping_factor),
+        one("simulate.ramp_s", s.ramp_s),
+        ("simulate.start_unix_s", "simulate.start_unix_s".into(), s.start_unix_s),
+        one("simulate.sea.hs_m", s.sea.hs_m),
+        one("simulate.sea.tp_s", s.sea.tp_s),
+        one("simulate.sea.gamma", s.sea.gamma),
+        one("simulate.sea.towards_deg", s.sea.towards_deg),
+        (
+            "simulate.sea.spreading_s",
+            "simulate.sea.spreading_s".into(),
+            s.sea.spreading_s,
+        ),
+        one("simulate.sea.components", s.sea.components as f64),
+        one("simulate.sea.omega_min_rad_s", s.sea.omega_min_rad_s),
+        one("simulate.sea.omega_max_rad_s", s.sea.omega_max_rad_s),
+        one("simulate.radar.radius_m", s.radar.radius_m),
+        one("simulate.radar.cells", s.radar.cells as f64),
+        one("simulate.radar.period_s", s.radar.period_s),
+        one("simulate.radar.noise_m", s.radar.noise_m),
+        one("simulate.radar.snapshots", s.radar.snapshots as f64),
+        one("simulate.radar.record_grid_every", s.radar.record_grid_every as f64),
+        one("simulate.imu.rate_hz", s.imu.rate_hz),
+        one("simulate.imu.noise_m", s.imu.noise_m),
+        one("simulate.imu.noise_rad", s.imu.noise_rad),
+        one("simulate.imu.bias_m", s.imu.bias_m),
+        one("simulate.imu.bias_rad", s.imu.bias_rad),
+        one("operation.duration_s", c.operation.duration_s),
+        one("console.history_s", c.console.history_s),
+    ];
+    for (i, ch) in c.operation.channels.iter().enumerate() {
+        out.push((
+            "operation.channels.limit",
+            format!("operation.channels[{i}].limit"),
+            Some(ch.limit),
         ));
     }
-    pos("forecast.max_clock_skew_s", f.max_clock_skew_s)?;
-    pos("forecast.max_clock_lag_s", f.max_clock_lag_s)?;
-    if let Some(r) = f.max_clock_rate
-        && !(r.is_finite() && (1.0..=1000.0).contains(&r))
-    {
-        return Err((
-            "forecast.max_clock_rate".into(),
-            format!("must be in [1, 1000], found {r}"),
-        ));
+    out
+}
+
+/// Keys whose value is a number (a boolean there is an error, not 0 or 1).
+fn is_numeric_key(key: &str) -> bool {
+    bound(key).is_some() || ["forecast.dt_s", "forecast.memory_s", "simulate.seed"].contains(&key)
+}
+
+/// Level names `log.level` takes alone or beside `target=level` directives.
+const LOG_LEVELS: [&str; 6] = ["trace", "debug", "info", "warn", "error", "off"];
+
+/// `log.level`: level names and `target=level` directives, comma-separated, as tracing's EnvFilter reads
+/// them; a bare word must be a level name (EnvFilter would take it for a target and log nothing else).
+fn check_log_level(level: &str) -> Result<(), String> {
+    for part in level.split(',') {
+        let p = part.trim();
+        if !p.contains('=') && !LOG_LEVELS.contains(&p.to_ascii_lowercase().as_str()) {
+            return Err(format!(
+                "`{p}` is not a level: expected one of {} or `target=level` directives, found \"{level}\"",
+                LOG_LEVELS.join(", ")
+            ));
+        }
     }
-    if !(1..=1000).contains(&f.clock_resync_samples) {
-        return Err((
-            "forecast.clock_resync_samples".into(),
-            format!("must be in 1..=1000, found {}", f.clock_resync_samples),
-        ));
+    tracing_subscriber::EnvFilter::try_new(level)
+        .map(|_| ())
+        .map_err(|e| format!("not a log filter: \"{level}\": {e}"))
+}
+
+/// The service names the prefix makes, as iceoryx2 parses them.
+fn check_service_prefix(prefix: &str) -> Result<(), String> {
+    for kind in ["motion", "waves", "forecast", "status"] {
+        let name = format!("{prefix}/{kind}");
+        if let Err(e) = iceoryx2::prelude::ServiceName::new(&name) {
+            return Err(format!(
+                "\"{prefix}\" does not make an iceoryx2 service name (`{name}`: {e:?}; ASCII without NUL, at most {} bytes, not starting with `iox2://`)",
+                iceoryx2::constants::MAX_SERVICE_NAME_LENGTH
+            ));
+        }
     }
-    if !(0.0..=1.0).contains(&f.max_dropped_wave_share) {
-        return Err((
-            "forecast.max_dropped_wave_share".into(),
-            format!("must be in [0, 1], found {}", f.max_dropped_wave_share),
-        ));
+    Ok(())
+}
+
+/// The key and line (1-based) of a byte offset of a TOML text: `section.key` from the last table
+/// header before it and the key on its line.
+fn toml_key_at(text: &str, offset: usize) -> (String, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let mut section = String::new();
+    for l in before.lines() {
+        let l = l.trim();
+        if l.starts_with('[') && !l.starts_with("[[") {
+            section = l.trim_matches(|ch| ch == '[' || ch == ']').trim().to_string();
+        }
     }
-    if f.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
+    let this = text.lines().nth(line - 1).unwrap_or("");
+    let key = this.split('=').next().unwrap_or("").trim();
+    let full = match (section.is_empty(), key.is_empty()) {
+        (_, true) => section,
+        (true, false) => key.to_string(),
+        (false, false) => format!("{section}.{key}"),
+    };
+    (full, line)
+}
+
+fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
+    for (bkey, key, v) in numbers(c) {
+        let (Some(v), Some(b)) = (v, bound(bkey)) else {
+            continue;
+        };
+        if !b.contains(v) {
+            return Err((key, format!("must be in {}, found {v:?}", b.range())));
+        }
+    }
+    let f = &c.forecast;
+    crate::service::rom_options(c)
+        .validate()
+        .map_err(|e| (format!("forecast.{}", e.field), e.msg))?;
+    let steps = f.horizon_s / f.dt_s;
+    if steps > crate::rom::forecast::MAX_FORECAST_STEPS as f64 {
         return Err((
             "forecast.horizon_s".into(),
             format!(
-                "at most {} s, found {}",
-                crate::rom::forecast::MAX_FORECAST_LENGTH_S,
-                f.horizon_s
+                "{} s at forecast.dt_s = {} s is {steps:.0} steps, more than {}",
+                f.horizon_s,
+                f.dt_s,
+                crate::rom::forecast::MAX_FORECAST_STEPS
+            ),
+        ));
+    }
+    if f.suppress_wave_age_s < f.max_wave_age_s {
+        return Err((
+            "forecast.suppress_wave_age_s".into(),
+            format!(
+                "must be at least forecast.max_wave_age_s ({} s), found {}",
+                f.max_wave_age_s, f.suppress_wave_age_s
             ),
         ));
     }
@@ -566,41 +822,57 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             format!("expected \"human\" or \"json\", found \"{}\"", c.log.format),
         ));
     }
+    check_log_level(&c.log.level).map_err(|m| ("log.level".to_string(), m))?;
     if c.ipc.service_prefix.is_empty() || c.ipc.service_prefix.len() > 200 {
         return Err(("ipc.service_prefix".into(), "must be 1..200 characters".into()));
     }
-    if !(c.record.rotate_mb.is_finite() && c.record.rotate_mb > 0.0) {
-        return Err((
-            "record.rotate_mb".into(),
-            format!("must be positive, found {}", c.record.rotate_mb),
-        ));
-    }
-    if let Some(r) = c.record.rotate_s {
-        pos("record.rotate_s", r)?;
-    }
-    pos("operation.duration_s", c.operation.duration_s)?;
-    for (i, ch) in c.operation.channels.iter().enumerate() {
-        pos(&format!("operation.channels[{i}].limit"), ch.limit)?;
-    }
-    pos("console.history_s", c.console.history_s)?;
+    check_service_prefix(&c.ipc.service_prefix).map_err(|m| ("ipc.service_prefix".to_string(), m))?;
     c.console.colours.parse()?;
-    let s = &c.simulate;
-    pos("simulate.duration_s", s.duration_s)?;
-    pos("simulate.speed", s.speed)?;
-    pos("simulate.damping_factor", s.damping_factor)?;
-    pos("simulate.sea.hs_m", s.sea.hs_m)?;
-    pos("simulate.sea.tp_s", s.sea.tp_s)?;
-    pos("simulate.radar.radius_m", s.radar.radius_m)?;
-    pos("simulate.radar.period_s", s.radar.period_s)?;
-    pos("simulate.imu.rate_hz", s.imu.rate_hz)?;
-    if let Some(t) = s.start_unix_s {
-        pos("simulate.start_unix_s", t)?;
-    }
-    if !(8..=1024).contains(&s.radar.cells) {
+    let sea = &c.simulate.sea;
+    if sea.omega_min_rad_s >= sea.omega_max_rad_s {
         return Err((
-            "simulate.radar.cells".into(),
-            format!("must be in 8..=1024, found {}", s.radar.cells),
+            "simulate.sea.omega_max_rad_s".into(),
+            format!(
+                "must be above simulate.sea.omega_min_rad_s ({} rad/s), found {}",
+                sea.omega_min_rad_s, sea.omega_max_rad_s
+            ),
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every key of the table is checked, and every checked key has a bound.
+    #[test]
+    fn every_numeric_key_has_one_bound() {
+        let mut c: ShipcastConfig = toml::from_str("[system]\nfile = \"s.toml\"\n").unwrap();
+        c.operation.channels.push(ChannelConfig {
+            name: "a.heave".into(),
+            limit: 1.0,
+        });
+        c.record.rotate_s = Some(1.0);
+        c.simulate.sea.spreading_s = Some(1.0);
+        c.simulate.start_unix_s = Some(1.75e9);
+        let keys: Vec<&str> = numbers(&c).iter().map(|n| n.0).collect();
+        for b in BOUNDS {
+            assert_eq!(keys.iter().filter(|k| **k == b.key).count(), 1, "{}", b.key);
+        }
+        for k in keys {
+            assert!(bound(k).is_some(), "{k}");
+        }
+        validate(&c).unwrap();
+    }
+
+    #[test]
+    fn log_levels() {
+        for ok in ["info", "WARN", "shipcast=debug,warn", "off"] {
+            check_log_level(ok).unwrap();
+        }
+        for bad in ["loud", "info,loud", "shipcast=loud"] {
+            assert!(check_log_level(bad).is_err(), "{bad}");
+        }
+    }
 }
