@@ -670,7 +670,11 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("forecast.max_clock_skew_s", f.max_clock_skew_s),
         one("forecast.max_clock_lag_s", f.max_clock_lag_s),
         one("forecast.clock_resync_samples", f.clock_resync_samples as f64),
-        ("forecast.max_clock_rate", "forecast.max_clock_rate".to_string(), f.max_clock_rate),
+        (
+            "forecast.max_clock_rate",
+            "forecast.max_clock_rate".to_string(),
+            f.max_clock_rate,
+        ),
         one("forecast.max_dropped_wave_share", f.max_dropped_wave_share),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
