@@ -368,6 +368,7 @@ pub enum Received {
 
 /// A blocking subscriber of forecasts and status (`shipcast watch`, consoles, tests).
 pub struct ForecastSubscriber {
+    refused: std::cell::Cell<u64>,
     _node: Node<ipc::Service>,
     forecast: Subscriber<ipc::Service, [f64], ForecastHeader>,
     status: Subscriber<ipc::Service, Status, ()>,
@@ -393,21 +394,42 @@ impl ForecastSubscriber {
             _node: node,
             forecast,
             status,
+            refused: std::cell::Cell::new(0),
             fc_l,
             st_l,
             ws: waitset()?,
         })
     }
 
-    /// Everything received so far, without waiting.
+    /// Payloads refused so far (their header does not fit their data, or an unknown schema).
+    pub fn refused(&self) -> u64 {
+        self.refused.get()
+    }
+
+    fn refuse(&self, why: String) {
+        let n = self.refused.get() + 1;
+        self.refused.set(n);
+        if n == 1 || n.is_power_of_two() {
+            tracing::warn!(refused = n, "{why}: skipped");
+        }
+    }
+
+    /// Everything received so far, without waiting; a payload whose header does not fit its data
+    /// ([`check_forecast`], [`check_status`]) is skipped and counted ([`Self::refused`]).
     pub fn drain(&self, out: &mut Vec<Received>) -> Result<()> {
         let _ = self.fc_l.try_wait(|_| {});
         let _ = self.st_l.try_wait(|_| {});
         while let Some(s) = self.status.receive().map_err(err)? {
-            out.push(Received::Status(*s.payload()));
+            match check_status(s.payload()) {
+                Ok(()) => out.push(Received::Status(*s.payload())),
+                Err(e) => self.refuse(e),
+            }
         }
         while let Some(s) = self.forecast.receive().map_err(err)? {
-            out.push(Received::Forecast(*s.user_header(), s.payload().to_vec()));
+            match check_forecast(s.user_header(), s.payload().len()) {
+                Ok(()) => out.push(Received::Forecast(*s.user_header(), s.payload().to_vec())),
+                Err(e) => self.refuse(e),
+            }
         }
         Ok(())
     }

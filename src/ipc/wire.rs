@@ -216,9 +216,122 @@ pub struct Status {
     pub reserved: u32,
 }
 
+/// Checks a received forecast against its own header, as every consumer must before indexing it
+/// (`ForecastSubscriber` does, for `watch`, `demo` and the console): the schema, the vessel count, the
+/// series count and the payload's length, a positive step, finite times and horizons.
+pub fn check_forecast(h: &ForecastHeader, payload_len: usize) -> Result<(), String> {
+    let n_vessels = h.n_vessels as usize;
+    if h.schema_version != SCHEMA_VERSION {
+        return Err(format!(
+            "forecast of schema version {} (this shipcast reads {SCHEMA_VERSION})",
+            h.schema_version
+        ));
+    }
+    if n_vessels == 0 || n_vessels > MAX_VESSELS {
+        return Err(format!("forecast for {n_vessels} vessels (1..={MAX_VESSELS})"));
+    }
+    if h.n_series as usize != 6 * n_vessels {
+        return Err(format!(
+            "forecast with {} series for {n_vessels} vessels (6 each)",
+            h.n_series
+        ));
+    }
+    let values = (h.steps as usize + 1).checked_mul(h.n_series as usize);
+    if values != Some(payload_len) {
+        return Err(format!(
+            "forecast of {} steps x {} series in {payload_len} values",
+            h.steps, h.n_series
+        ));
+    }
+    if !(h.dt_s.is_finite() && h.dt_s > 0.0 && h.issue_time_s.is_finite()) {
+        return Err(format!(
+            "forecast with dt_s {} and issue_time_s {}",
+            h.dt_s, h.issue_time_s
+        ));
+    }
+    if h.horizon_s[..n_vessels].iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        return Err(format!("forecast with horizons {:?}", &h.horizon_s[..n_vessels]));
+    }
+    Ok(())
+}
+
+/// Checks a received status: its schema version.
+pub fn check_status(s: &Status) -> Result<(), String> {
+    if s.schema_version != STATUS_SCHEMA_VERSION {
+        return Err(format!(
+            "status of schema version {} (this shipcast reads {STATUS_SCHEMA_VERSION})",
+            s.schema_version
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn good() -> ForecastHeader {
+        ForecastHeader {
+            schema_version: SCHEMA_VERSION,
+            n_vessels: 2,
+            dt_s: 0.1,
+            steps: 10,
+            n_series: 12,
+            ..ForecastHeader::default()
+        }
+    }
+
+    /// Was: `watch`, `demo` and the console indexed payloads by their header unchecked (`n_vessels` > 4,
+    /// or `steps` larger than the payload, panicked).
+    #[test]
+    fn a_forecast_whose_header_does_not_fit_its_payload_is_refused() {
+        assert_eq!(check_forecast(&good(), 11 * 12), Ok(()));
+        let bad = [
+            (
+                ForecastHeader {
+                    n_vessels: 5,
+                    n_series: 30,
+                    ..good()
+                },
+                11 * 30,
+            ),
+            (
+                ForecastHeader {
+                    n_vessels: 0,
+                    n_series: 0,
+                    ..good()
+                },
+                0,
+            ),
+            (ForecastHeader { steps: 1000, ..good() }, 11 * 12),
+            (
+                ForecastHeader {
+                    steps: u32::MAX,
+                    ..good()
+                },
+                11 * 12,
+            ),
+            (ForecastHeader { n_series: 6, ..good() }, 11 * 6),
+            (ForecastHeader { dt_s: 0.0, ..good() }, 11 * 12),
+            (
+                ForecastHeader {
+                    schema_version: 9,
+                    ..good()
+                },
+                11 * 12,
+            ),
+            (
+                ForecastHeader {
+                    horizon_s: [f64::INFINITY, 0.0, 0.0, 0.0],
+                    ..good()
+                },
+                11 * 12,
+            ),
+        ];
+        for (h, len) in bad {
+            assert!(check_forecast(&h, len).is_err(), "{h:?}");
+        }
+    }
 
     #[test]
     fn layouts_are_what_the_docs_say() {
