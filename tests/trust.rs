@@ -318,3 +318,93 @@ fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_truste
     let share = run.statuses.last().unwrap().dropped_wave_share;
     assert!((share - 0.5).abs() < 0.05, "{share}");
 }
+
+/// A fault put into one record of the log.
+#[derive(Debug, Clone, Copy)]
+enum Fault {
+    NanValue,
+    NanStamp,
+    InfStamp,
+    /// The stamp moved by this many seconds (ahead or behind).
+    Stamp(f64),
+    /// A finite but absurd displacement and velocity (m, m/s).
+    Spike(f64),
+    /// The record sent twice.
+    Duplicate,
+    /// The record swapped with the next one (out of order).
+    Swap,
+    /// The wave field emptied, or its region forgotten.
+    EmptyField,
+    UnknownRegion,
+}
+
+fn apply(records: &mut Vec<(f64, Record)>, at: usize, fault: Fault) {
+    let at = at.min(records.len() - 2);
+    match (&mut records[at].1, fault) {
+        (Record::Motion(m), Fault::NanValue) => m.x[2] = f64::NAN,
+        (Record::Motion(m), Fault::NanStamp) => m.time_s = f64::NAN,
+        (Record::Motion(m), Fault::InfStamp) => m.time_s = f64::INFINITY,
+        (Record::Motion(m), Fault::Stamp(d)) => m.time_s += d,
+        (Record::Motion(m), Fault::Spike(v)) => {
+            m.x = [v; 6];
+            m.v = [v; 6];
+        }
+        (Record::Waves(w), Fault::NanValue) => w.components.iter_mut().for_each(|c| c[2] = f64::NAN),
+        (Record::Waves(w), Fault::NanStamp) => w.time_s = f64::NAN,
+        (Record::Waves(w), Fault::InfStamp) => w.time_s = f64::INFINITY,
+        (Record::Waves(w), Fault::Stamp(d)) => w.time_s += d,
+        (Record::Waves(w), Fault::EmptyField) => w.components.clear(),
+        (Record::Waves(w), Fault::UnknownRegion) => w.radius_m = 0.0,
+        (_, Fault::Duplicate) => {
+            let r = records[at].clone();
+            records.insert(at, r);
+        }
+        (_, Fault::Swap) => records.swap(at, at + 1),
+        _ => {}
+    }
+}
+
+fn fault() -> impl proptest::strategy::Strategy<Value = Fault> {
+    use proptest::prelude::*;
+    prop_oneof![
+        Just(Fault::NanValue),
+        Just(Fault::NanStamp),
+        Just(Fault::InfStamp),
+        prop_oneof![-1e9..-1.0f64, 1.0..1e9f64].prop_map(Fault::Stamp),
+        prop_oneof![Just(1e6), Just(-1e6), Just(1e300)].prop_map(Fault::Spike),
+        Just(Fault::Duplicate),
+        Just(Fault::Swap),
+        Just(Fault::EmptyField),
+        Just(Fault::UnknownRegion),
+    ]
+}
+
+/// Forecasts are back this long after the last fault, s: the 60 s radiation memory (a spike sits in
+/// the history for as long) and ten periods.
+const RECOVERY_S: f64 = 70.0;
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+    /// Any mix of faults in the first half of the log: every output keeps the invariants (finite
+    /// values and horizons, ages never negative, no horizon from a field that says nothing), and once
+    /// the inputs are good again forecasts come back within RECOVERY_S.
+    #[test]
+    fn random_faults_never_break_the_invariants_and_forecasts_recover(
+        faults in proptest::collection::vec((0.0..0.5f64, fault()), 1..25)
+    ) {
+        let mut records = log().records.clone();
+        let n = records.len();
+        for (at, f) in &faults {
+            apply(&mut records, (at * n as f64) as usize, *f);
+        }
+        let run = drive(&records);
+        invariants(&run);
+        let t0 = start(&log().records);
+        let last_fault_s = LOG_S * 0.5;
+        let back = after(&run, t0, last_fault_s + RECOVERY_S);
+        proptest::prop_assert!(!back.is_empty(), "no forecast after {} s: {faults:?}", last_fault_s + RECOVERY_S);
+        for h in back {
+            proptest::prop_assert!(h.horizon_s[0] > 0.0, "{:?}", flags::names(h.flags));
+        }
+    }
+}
