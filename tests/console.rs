@@ -156,7 +156,7 @@ fn a_bad_channel_or_colour_is_named_before_the_screen_opens() {
     );
     let e = run("[operation]\nchannels = [{ name = \"carrier.roll\", limit = -2.0 }]\n");
     assert!(
-        e.contains("operation.channels[0].limit") && e.contains("positive"),
+        e.contains("operation.channels[0].limit") && e.contains("must be in (0, ") && e.contains("-2"),
         "{e}"
     );
     let e = run("[console.colours]\nforecast = \"blurple\"\n");
