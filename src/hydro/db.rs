@@ -185,12 +185,6 @@ impl HydroDb {
         Ok(out)
     }
 
-    /// Whether the excitation is known at (omega, heading): inside the frequency range and the headings
-    /// (what [`Self::excitation_into`] accepts).
-    pub fn covers(&self, omega_rad_s: f64, heading_rad: f64) -> bool {
-        bracket(&self.exc_omega_rad_s, omega_rad_s).is_some() && self.heading_bracket(heading_rad).is_ok()
-    }
-
     /// As [`Self::excitation_at`], into `out` (length n_modes): no allocation.
     pub fn excitation_into(&self, omega_rad_s: f64, heading_rad: f64, out: &mut [Complex64]) -> Result<()> {
         let ws = &self.exc_omega_rad_s;

@@ -103,6 +103,8 @@ pub struct Done {
     pub values: Option<Vec<f64>>,
     pub compute_ms: f64,
     pub error: Option<String>,
+    /// Share of the wave variance the forecast left out (outside the database), 0..1.
+    pub dropped_wave_share: f64,
 }
 
 /// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
@@ -141,7 +143,7 @@ impl Computer {
                 for i in 0..6 * n_bodies {
                     values.extend((0..=f.steps).map(|k| f.at(k, i)));
                 }
-                (values, f.steps)
+                (values, f.steps, f.skipped_variance_fraction)
             })
         });
         let compute_ms = elapsed_ms();
@@ -149,13 +151,14 @@ impl Computer {
         header.compute_ms = compute_ms;
         header.issue_time_s = job.t0_s;
         match result {
-            Ok((values, steps)) => {
+            Ok((values, steps, dropped_wave_share)) => {
                 header.steps = steps as u32;
                 Done {
                     header,
                     values: Some(values),
                     compute_ms,
                     error: None,
+                    dropped_wave_share,
                 }
             }
             Err(e) => Done {
@@ -163,6 +166,7 @@ impl Computer {
                 values: None,
                 compute_ms,
                 error: Some(e.to_string()),
+                dropped_wave_share: 0.0,
             },
         }
     }
@@ -283,8 +287,6 @@ pub struct Engine {
     clock_rules: clock::ClockRules,
     /// Motion kept per vessel, s.
     keep_s: f64,
-    /// The database the forecasts use: which wave components it covers.
-    db: crate::hydro::db::HydroDb,
     /// Share of the last forecast's wave variance outside the database.
     dropped_wave_share: f64,
     /// Whether the last tick could forecast (for the log line when that changes).
@@ -329,7 +331,6 @@ impl Engine {
                 max_rate: cfg.forecast.max_clock_rate.unwrap_or(cfg.simulate.speed).max(1.0),
             },
             keep_s,
-            db: model.db.clone(),
             dropped_wave_share: 0.0,
             forecasting: None,
             counters: Counters::default(),
@@ -339,6 +340,14 @@ impl Engine {
             last_horizon: [0.0; MAX_VESSELS],
             state_flags: 0,
         }
+    }
+
+    /// The earliest and the latest of the vessels' newest motion stamps, s (+inf and -inf before any).
+    fn newest_motion_s(&self) -> (f64, f64) {
+        self.hist
+            .iter()
+            .filter_map(|h| h.newest_time_s())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)))
     }
 
     /// Radiation memory the engine keeps, s.
@@ -439,18 +448,9 @@ impl Engine {
         if motion_ok.iter().any(|ok| !ok) {
             fl |= flags::STALE_MOTION;
         }
-        let t0 = self
-            .hist
-            .iter()
-            .filter_map(|h| h.newest_time_s())
-            .fold(f64::INFINITY, f64::min);
+        let (t0, newest) = self.newest_motion_s();
         // the sources' clocks must agree: vessels' newest motion within the staleness and the skew of
         // each other, and no wave field from after the motion beyond the skew
-        let newest = self
-            .hist
-            .iter()
-            .filter_map(|h| h.newest_time_s())
-            .fold(f64::NEG_INFINITY, f64::max);
         let mut disagree = newest - t0 > cfg.max_motion_age_s + cfg.max_clock_skew_s;
         if let Some(f) = &self.field
             && f.time_s - t0 > cfg.max_clock_skew_s
@@ -523,19 +523,8 @@ impl Engine {
                     ..ForecastHeader::default()
                 };
                 let waves = f.for_vessel(self.origin_m, self.heading, t0);
-                let (mut total, mut dropped) = (0.0, 0.0);
-                for w in &waves {
-                    let var = 0.5 * w.amplitude_m.norm_sqr();
-                    total += var;
-                    if !self.db.covers(w.omega_rad_s, w.heading_rad) {
-                        dropped += var;
-                    }
-                }
-                self.dropped_wave_share = if total > 0.0 { dropped / total } else { 0.0 };
-                if dropped > 0.0 {
-                    header.flags |= flags::WAVES_DROPPED;
-                }
-                // what the field says about where it was observed decides how far it is trusted
+                // what the field says about where it was observed decides how far it is trusted (and
+                // the variance the forecast leaves out, in `done`)
                 let known = match f.region {
                     _ if f.components.is_empty() => {
                         header.flags |= flags::NO_WAVE_COMPONENTS;
@@ -545,7 +534,7 @@ impl Engine {
                         header.flags |= flags::WAVE_REGION_UNKNOWN;
                         false
                     }
-                    _ => self.dropped_wave_share <= cfg.max_dropped_wave_share,
+                    _ => true,
                 };
                 for (b, p) in self.positions.iter().enumerate() {
                     let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0).horizon_s - (t0 - f.time_s).max(0.0);
@@ -573,10 +562,18 @@ impl Engine {
         self.last_compute_ms = d.compute_ms;
         match (d.values, d.error) {
             (Some(values), _) => {
+                let mut header = d.header;
+                self.dropped_wave_share = d.dropped_wave_share;
+                if d.dropped_wave_share > 0.0 {
+                    header.flags |= flags::WAVES_DROPPED;
+                }
+                if d.dropped_wave_share > self.cfg.max_dropped_wave_share {
+                    header.horizon_s = [0.0; MAX_VESSELS];
+                }
                 self.counters.forecasts += 1;
-                self.last_forecast_time = d.header.issue_time_s;
-                self.last_horizon = d.header.horizon_s;
-                Some(Output::Forecast(d.header, values))
+                self.last_forecast_time = header.issue_time_s;
+                self.last_horizon = header.horizon_s;
+                Some(Output::Forecast(header, values))
             }
             (None, e) => {
                 self.state_flags |= flags::NUMERICAL;
@@ -588,15 +585,16 @@ impl Engine {
 
     /// The status at `clock_s` (`wall_s`: the wall clock to stamp it with); clears the one-shot flags.
     pub fn status(&mut self, clock_s: f64, wall_s: f64, running: bool) -> Status {
+        let now_data = self.newest_motion_s().1;
         let c = &self.counters;
-        let now_data = self
-            .hist
-            .iter()
-            .filter_map(|h| h.newest_time_s())
-            .fold(f64::NEG_INFINITY, f64::max);
+        let waves_dropped = if self.dropped_wave_share > 0.0 {
+            flags::WAVES_DROPPED
+        } else {
+            0
+        };
         let mut s = Status {
             schema_version: crate::ipc::wire::STATUS_SCHEMA_VERSION,
-            flags: self.state_flags,
+            flags: self.state_flags | waves_dropped,
             time_s: if now_data.is_finite() { now_data } else { -1.0 },
             wall_time_s: wall_s,
             wave_age_s: match &self.field {
