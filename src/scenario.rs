@@ -130,15 +130,14 @@ impl Scenario {
                 return Err(bad(k, format!("must be positive, found {v}")));
             }
         }
-        if raw.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
-            return Err(bad(
-                "horizon_s",
-                format!(
-                    "at most {} s, found {}",
-                    crate::rom::forecast::MAX_FORECAST_LENGTH_S,
-                    raw.horizon_s
-                ),
-            ));
+        // both are runs of the model, sized steps x states
+        for (k, v) in [("horizon_s", raw.horizon_s), ("history_s", raw.history_s)] {
+            if v > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
+                return Err(bad(
+                    k,
+                    format!("at most {} s, found {v}", crate::rom::forecast::MAX_FORECAST_LENGTH_S),
+                ));
+            }
         }
         if let Some(r) = raw.radar_radius_m
             && !(r.is_finite() && r > 0.0)

@@ -144,3 +144,18 @@ fn forecast_columns_carry_their_units_and_rotations_are_degrees() {
         "pitch in degrees barely moves"
     );
 }
+
+/// Was: a scenario's `history_s` had no upper bound (the spin-up's buffers are sized by it).
+#[test]
+fn a_scenario_history_beyond_the_longest_run_is_refused_with_the_key() {
+    let system = repo("config/vessels/ship/system.toml");
+    let text = std::fs::read_to_string(repo(SCENARIO))
+        .unwrap()
+        .replace("../../../config/vessels/ship/system.toml", system.to_str().unwrap())
+        .replace("history_s = 120.0", "history_s = 1e9");
+    let path = scratch_dir("scenario-history").join("scenario.toml");
+    std::fs::write(&path, text).unwrap();
+    let (ok, _, err) = shipcast(&["forecast", path.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("history_s") && err.contains("at most 3600 s"), "{err}");
+}

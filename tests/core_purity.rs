@@ -12,7 +12,8 @@ const CORE: &[&str] = &[
     "src/rom",
     "src/skill.rs",
     "src/sim.rs",
-    "src/service/history.rs",
+    "src/service/estimator.rs",
+    "src/service/clock.rs",
     "src/operation.rs",
     "src/console",
 ];

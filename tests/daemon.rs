@@ -620,3 +620,39 @@ fn a_killed_daemon_restarts_and_forecasts_again() {
     eprintln!("forecasts: {before} before the daemon was killed, {after} from the restarted one");
     assert!(before >= 3 && after >= 3);
 }
+
+/// Was: a compute-thread panic left the daemon alive, pinging the systemd watchdog, forecasting nothing.
+/// The panic is injected with `SHIPCAST_FAULT=compute-panic` (the compute thread panics on its first job).
+#[test]
+fn a_panic_in_the_compute_thread_ends_the_daemon_with_an_error() {
+    let dir = crate::util::scratch_dir("daemon-panic");
+    let cfg = config(&dir, "panic", "");
+    let mut d = Command::new(bin())
+        .args(["run", "--config", cfg.to_str().unwrap()])
+        .env(shipcast::service::FAULT_ENV, "compute-panic")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("shipcast starts");
+    std::thread::sleep(Duration::from_millis(1500));
+    let _sim = simulator(&cfg, "120", &[]);
+    let t = Instant::now();
+    let status = loop {
+        if let Some(s) = d.try_wait().unwrap() {
+            break s;
+        }
+        if t.elapsed() > Duration::from_secs(90) {
+            let _ = d.kill();
+            panic!("the daemon still runs 90 s after its compute thread was made to panic");
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut d.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success(), "{status:?}: {err}");
+    assert!(err.contains("compute thread"), "{err}");
+    eprintln!(
+        "the daemon ended {:.1} s after the simulator started: {status}",
+        t.elapsed().as_secs_f64()
+    );
+}

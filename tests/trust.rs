@@ -294,6 +294,163 @@ fn refused_samples_are_counted_in_the_status() {
     assert_eq!(run.statuses.last().unwrap().dropped_rejected, 1);
 }
 
+/// The true displacement of vessel 0's DOF `dof` at stamp `t_s` (linear between the log's `/truth`
+/// samples).
+fn truth_at(records: &[(f64, Record)], t_s: f64, dof: usize) -> f64 {
+    let truth: Vec<(f64, f64)> = records
+        .iter()
+        .filter_map(|(_, r)| match r {
+            Record::Truth(m) if m.vessel == 0 => Some((m.time_s, m.x[dof])),
+            _ => None,
+        })
+        .collect();
+    let k = truth.partition_point(|(t, _)| *t <= t_s).clamp(1, truth.len() - 1);
+    let ((ta, a), (tb, b)) = (truth[k - 1], truth[k]);
+    a + (b - a) * (t_s - ta) / (tb - ta)
+}
+
+/// A forecast's first value of DOF `dof` of vessel 0.
+fn initial(h: &ForecastHeader, v: &[f64], dof: usize) -> f64 {
+    v[dof * (h.steps as usize + 1)]
+}
+
+/// A forecast's initial heave and pitch may differ from the true ones by this much (m, rad): five
+/// times the IMU's noise (0.01 m and 0.0005 rad in `config/one-ship.toml`).
+const INITIAL_STATE_TOL: [(usize, f64); 2] = [(2, 0.05), (4, 0.0025)];
+
+/// Was: an IMU stall of 1.9 s around a forecast's start gave that vessel an initial state of exactly
+/// zero (heave 0.000 m where it was 0.69 m), published with only `history_short`. A stalled sensor
+/// either stops sending or sends zeros (an empty field read as 0); both are bridged now.
+#[test]
+fn an_imu_stall_is_bridged_and_the_initial_state_follows_the_motion() {
+    const STALL_S: f64 = 1.9;
+    for zeros in [true, false] {
+        let mut records = log().records.clone();
+        let t0 = start(&records);
+        // the stall is centred on the largest pitch in the ten seconds after the fault time (the ship
+        // heads into the waves: pitch is its largest motion)
+        let centre_s = (0..100)
+            .map(|k| t0 + FAULT_AT_S + 0.1 * k as f64)
+            .max_by(|a, b| {
+                truth_at(&records, *a, 4)
+                    .abs()
+                    .total_cmp(&truth_at(&records, *b, 4).abs())
+            })
+            .unwrap();
+        let (a_s, b_s) = (centre_s - STALL_S / 2.0, centre_s + STALL_S / 2.0);
+        let stalled = |r: &Record| matches!(r, Record::Motion(m) if m.time_s > a_s && m.time_s < b_s);
+        if zeros {
+            for (_, r) in records.iter_mut() {
+                if stalled(r)
+                    && let Record::Motion(m) = r
+                {
+                    m.x = [0.0; 6];
+                    m.v = [0.0; 6];
+                }
+            }
+        } else {
+            records.retain(|(_, r)| !stalled(r));
+        }
+        let run = drive(&records);
+        invariants(&run);
+        let near: Vec<&(ForecastHeader, Vec<f64>)> = run
+            .forecasts
+            .iter()
+            .filter(|(h, _)| (h.issue_time_s - centre_s).abs() < 10.0)
+            .collect();
+        assert!(near.len() > 10, "{} forecasts near the stall", near.len());
+        for (h, v) in near {
+            let what = if zeros { "zeros" } else { "no samples" };
+            for (dof, tol) in INITIAL_STATE_TOL {
+                let (got, truth) = (initial(h, v, dof), truth_at(&records, h.issue_time_s, dof));
+                assert!(
+                    (got - truth).abs() < tol,
+                    "{what} for {STALL_S} s: forecast at {:.1} s: initial DOF {dof} {got:.4}, true {truth:.4} ({:?})",
+                    h.issue_time_s - t0,
+                    flags::names(h.flags)
+                );
+            }
+            assert!(
+                h.flags & flags::HISTORY_SHORT == 0,
+                "{what} for {STALL_S} s: forecast at {:.1} s: the gap ended the history",
+                h.issue_time_s - t0
+            );
+        }
+    }
+}
+
+/// Was: one finite but absurd IMU sample (heave 1e6 m, 1e6 m/s) stopped forecasts for 2 minutes, then
+/// 173 forecasts with values up to 9.8 km were published, flagged only `history_short` (the spike sat in
+/// the radiation history for its whole memory).
+#[test]
+fn an_absurd_motion_sample_is_refused_and_never_enters_the_history() {
+    let (records, run) = one_fault(false, |r| {
+        if let Record::Motion(m) = r {
+            m.x = [1e6; 6];
+            m.v = [1e6; 6];
+        }
+    });
+    let t0 = start(&records);
+    let (base, got) = (after(baseline(), t0, FAULT_AT_S), after(&run, t0, FAULT_AT_S));
+    assert!(
+        got.len() + 2 >= base.len(),
+        "{} forecasts after the spike against {} without it",
+        got.len(),
+        base.len()
+    );
+    // the forecasts after the spike are those without it: the spike is not in their state or history
+    let largest = |run: &Run| {
+        run.forecasts
+            .iter()
+            .filter(|(h, _)| h.issue_time_s - t0 > FAULT_AT_S)
+            .flat_map(|(_, v)| v.iter())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let (base_max, got_max) = (largest(baseline()), largest(&run));
+    assert!(
+        got_max <= 1.01 * base_max,
+        "largest value {got_max} after the spike, {base_max} without it"
+    );
+    assert_eq!(run.statuses.last().unwrap().dropped_implausible, 1);
+    assert!(run.statuses.iter().any(|s| s.flags & flags::MOTION_IMPLAUSIBLE != 0));
+}
+
+/// Was: one 1M-component wave field took 1.1-1.6 s per forecast and left 640 MB that was never
+/// released.
+#[test]
+fn a_wave_field_of_a_million_components_is_refused_and_forecasts_go_on() {
+    let (records, run) = one_fault(true, |r| {
+        if let Record::Waves(w) = r {
+            let one = w.components.clone();
+            w.components = one.iter().cycle().take(1_000_000).copied().collect();
+        }
+    });
+    assert_eq!(run.statuses.last().unwrap().dropped_rejected, 1);
+    let t0 = start(&records);
+    let (base, got) = (
+        after(baseline(), t0, FAULT_AT_S).len(),
+        after(&run, t0, FAULT_AT_S).len(),
+    );
+    assert!(
+        got + 2 >= base,
+        "{got} forecasts after the field against {base} without it"
+    );
+}
+
+/// Was: a replay of a system with more than 4 bodies (more than the payloads carry) panicked.
+#[test]
+fn a_replay_of_more_vessels_than_the_payloads_carry_is_refused() {
+    let l = log();
+    let mut sys = l.sys.clone();
+    let body = sys.spec.bodies[0].clone();
+    sys.spec.bodies.extend(std::iter::repeat_n(body, 4));
+    let err = replay::drive(&l.cfg, &sys, &l.records, |_| {}, |_| {}).unwrap_err();
+    assert!(
+        err.to_string().contains("5 vessels") && err.to_string().contains("at most 4"),
+        "{err}"
+    );
+}
+
 /// Was: wave components outside the database's frequencies were dropped with nothing in the flags.
 #[test]
 fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_trusted() {
@@ -329,6 +486,8 @@ enum Fault {
     Stamp(f64),
     /// A finite but absurd displacement and velocity (m, m/s).
     Spike(f64),
+    /// The sensor stalled: this and the next records of the vessel repeat zeros.
+    Zeros,
     /// The record sent twice.
     Duplicate,
     /// The record swapped with the next one (out of order).
@@ -348,6 +507,14 @@ fn apply(records: &mut Vec<(f64, Record)>, at: usize, fault: Fault) {
         (Record::Motion(m), Fault::Spike(v)) => {
             m.x = [v; 6];
             m.v = [v; 6];
+        }
+        (Record::Motion(_), Fault::Zeros) => {
+            for (_, r) in records[at..].iter_mut().take(20) {
+                if let Record::Motion(m) = r {
+                    m.x = [0.0; 6];
+                    m.v = [0.0; 6];
+                }
+            }
         }
         (Record::Waves(w), Fault::NanValue) => w.components.iter_mut().for_each(|c| c[2] = f64::NAN),
         (Record::Waves(w), Fault::NanStamp) => w.time_s = f64::NAN,
@@ -372,6 +539,7 @@ fn fault() -> impl proptest::strategy::Strategy<Value = Fault> {
         Just(Fault::InfStamp),
         prop_oneof![-1e9..-1.0f64, 1.0..1e9f64].prop_map(Fault::Stamp),
         prop_oneof![Just(1e6), Just(-1e6), Just(1e300)].prop_map(Fault::Spike),
+        Just(Fault::Zeros),
         Just(Fault::Duplicate),
         Just(Fault::Swap),
         Just(Fault::EmptyField),
@@ -379,8 +547,8 @@ fn fault() -> impl proptest::strategy::Strategy<Value = Fault> {
     ]
 }
 
-/// Forecasts are back this long after the last fault, s: the 60 s radiation memory (a spike sits in
-/// the history for as long) and ten periods.
+/// Forecasts are back this long after the last fault, s: the 60 s radiation memory (a step of a
+/// clock restarts the history) and ten periods.
 const RECOVERY_S: f64 = 70.0;
 
 proptest::proptest! {

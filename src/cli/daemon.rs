@@ -410,6 +410,14 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
         "dropped_rejected": s.dropped_rejected,
         "clock_steps": s.clock_steps,
         "dropped_wave_share": finite(s.dropped_wave_share),
+        "dropped_implausible": s.dropped_implausible,
+        "motion_restarts": s.motion_restarts,
+        // heave m, roll and pitch deg, as the forecasts are shown
+        "motion_bias": s.motion_bias.iter().take(n_vessels).map(|b| serde_json::json!({
+            "heave_m": finite(b[0]),
+            "roll_deg": finite(b[1].to_degrees()),
+            "pitch_deg": finite(b[2].to_degrees()),
+        })).collect::<Vec<_>>(),
         "flags": flags::names(s.flags),
     })
     .to_string()

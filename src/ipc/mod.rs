@@ -123,6 +123,13 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
             h.schema_version
         ));
     }
+    if h.n_components as usize > crate::ipc::wire::MAX_WAVE_COMPONENTS {
+        return Err(format!(
+            "wave field of {} components, more than {} (a 256 x 256 radar grid's wavenumber bins)",
+            h.n_components,
+            crate::ipc::wire::MAX_WAVE_COMPONENTS
+        ));
+    }
     if payload.len() != 4 * h.n_components as usize {
         return Err(format!(
             "wave field: {} values for {} components (4 each)",
@@ -238,6 +245,8 @@ pub fn spawn_input(
 
 /// What the output thread publishes.
 #[derive(Debug, Clone)]
+// one status a period: a box would be an allocation for nothing
+#[allow(clippy::large_enum_variant)]
 pub enum Output {
     Forecast(ForecastHeader, Vec<f64>),
     Status(Status),
@@ -361,6 +370,8 @@ impl SensorPublisher {
 
 /// What a forecast subscriber receives.
 #[derive(Debug, Clone)]
+// one status a period: a box would be an allocation for nothing
+#[allow(clippy::large_enum_variant)]
 pub enum Received {
     Forecast(ForecastHeader, Vec<f64>),
     Status(Status),

@@ -21,10 +21,15 @@ use iceoryx2::prelude::*;
 
 /// Schema version of the motion, waves and forecast payloads.
 pub const SCHEMA_VERSION: u32 = 1;
-/// Schema version of [`Status`] (2: the drop counters by reason and the clock steps).
-pub const STATUS_SCHEMA_VERSION: u32 = 2;
+/// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
+/// estimator's refusals, restarts and bias).
+pub const STATUS_SCHEMA_VERSION: u32 = 3;
 /// Vessels a forecast or status can describe.
 pub const MAX_VESSELS: usize = 4;
+/// The most components a wave field may carry: the wavenumber bins of a 256 x 256 radar grid. A field
+/// with more is refused (each component is a sinusoid in every forecast's wave force, and the
+/// forecaster's buffers grow to the largest field seen).
+pub const MAX_WAVE_COMPONENTS: usize = 65_536;
 
 /// Quality flags of forecasts and status (bits).
 pub mod flags {
@@ -54,6 +59,12 @@ pub mod flags {
     /// The sources' clocks disagree (a wave field newer than the motion, or vessels' motion apart, by
     /// more than the clocks' skew allows): no forecast.
     pub const CLOCKS_DISAGREE: u32 = 2048;
+    /// A motion sample was refused as physically impossible (beyond the bounds, a jump no acceleration
+    /// makes, or a stalled sensor repeating itself) since the last status (status only).
+    pub const MOTION_IMPLAUSIBLE: u32 = 4096;
+    /// A vessel's motion estimate restarted from a run of refused samples that agree (a real jump),
+    /// since the last status (status only): its history restarts.
+    pub const MOTION_RESTARTED: u32 = 8192;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -70,6 +81,8 @@ pub mod flags {
             (WAVES_DROPPED, "waves_dropped"),
             (CLOCK_STEP, "clock_step"),
             (CLOCKS_DISAGREE, "clocks_disagree"),
+            (MOTION_IMPLAUSIBLE, "motion_implausible"),
+            (MOTION_RESTARTED, "motion_restarted"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)
@@ -171,9 +184,9 @@ pub struct ForecastHeader {
     pub horizon_s: [f64; MAX_VESSELS],
 }
 
-/// Health of the daemon, published every cycle. 248 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
+/// Health of the daemon, published every cycle. 360 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("shipcast_Status_v2")]
+#[type_name("shipcast_Status_v3")]
 #[repr(C)]
 pub struct Status {
     pub schema_version: u32,
@@ -205,12 +218,20 @@ pub struct Status {
     pub dropped_future: u64,
     /// ... or beyond `forecast.max_clock_lag_s` behind it.
     pub dropped_past: u64,
-    /// Samples refused for an unknown schema version or a vessel index out of range.
+    /// Samples refused for an unknown schema version or a vessel index out of range, and wave fields
+    /// of more than [`MAX_WAVE_COMPONENTS`] components.
     pub dropped_rejected: u64,
     /// Steps of a source's clock detected (the source re-synchronized).
     pub clock_steps: u64,
     /// Share of the last forecast's wave variance outside the database (left out), 0..1.
     pub dropped_wave_share: f64,
+    /// Motion samples refused by the estimator as physically impossible (flag `motion_implausible`).
+    pub dropped_implausible: u64,
+    /// Restarts of a vessel's motion estimate after a real jump (flag `motion_restarted`).
+    pub motion_restarts: u64,
+    /// Each vessel's estimated sensor bias taken off the initial state: heave (m), roll, pitch (rad)
+    /// (0 until it has averaged long enough; `estimator.method = "raw"`: 0).
+    pub motion_bias: [[f64; 3]; MAX_VESSELS],
     /// 1 while running, 0 in the last status before a clean shutdown.
     pub running: u32,
     pub reserved: u32,
@@ -338,6 +359,6 @@ mod tests {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
-        assert_eq!(std::mem::size_of::<Status>(), 248);
+        assert_eq!(std::mem::size_of::<Status>(), 360);
     }
 }

@@ -16,6 +16,8 @@ pub struct ShipcastConfig {
     #[serde(default)]
     pub forecast: ForecastConfig,
     #[serde(default)]
+    pub estimator: EstimatorConfig,
+    #[serde(default)]
     pub log: LogConfig,
     #[serde(default)]
     pub record: RecordConfig,
@@ -94,8 +96,8 @@ pub struct ForecastConfig {
     pub suppress_wave_age_s: f64,
     /// No motion sample received for this long (wall clock): stale motion, no forecast, s.
     pub max_motion_age_s: f64,
-    /// Gaps in the motion history up to this long are bridged linearly; a longer one ends the
-    /// history (what is before it counts as at rest), s.
+    /// Gaps in the motion history up to this long are bridged (by the estimator's curve through both
+    /// ends); a longer one ends the history (what is before it counts as at rest), s.
     pub max_gap_s: f64,
     /// Motion samples kept per vessel beyond the radiation memory, s.
     pub history_margin_s: f64,
@@ -129,7 +131,7 @@ impl Default for ForecastConfig {
             max_wave_age_s: 10.0,
             suppress_wave_age_s: 30.0,
             max_motion_age_s: 2.0,
-            max_gap_s: 1.0,
+            max_gap_s: 2.0,
             history_margin_s: 10.0,
             wave_variance_kept: 0.995,
             max_clock_skew_s: 1.0,
@@ -137,6 +139,46 @@ impl Default for ForecastConfig {
             clock_resync_samples: 5,
             max_clock_rate: None,
             max_dropped_wave_share: 0.1,
+        }
+    }
+}
+
+/// The motion state estimator ([`crate::service::estimator`]): how IMU samples become the state a
+/// forecast starts from.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EstimatorConfig {
+    /// "kalman" (filter, smoother, gating, bias) or "raw" (the samples as they come, for comparison).
+    pub method: crate::service::estimator::Method,
+    /// The motion sensor's noise (standard deviation): displacements, m and rad; velocities, m/s and
+    /// rad/s.
+    pub noise_m: f64,
+    pub noise_rad: f64,
+    pub velocity_noise_m_s: f64,
+    pub velocity_noise_rad_s: f64,
+    /// The largest acceleration of a translation, in g (rotations: over the radius of gyration).
+    pub max_acceleration_g: f64,
+    /// A change since the last estimate is allowed this many standard deviations beyond what the
+    /// largest acceleration makes.
+    pub gate_sigma: f64,
+    /// This many refused samples in a row that agree are a real jump: the estimate restarts from them.
+    pub reset_samples: u32,
+    /// Time constant of the bias average (heave, roll, pitch), s.
+    pub bias_time_s: f64,
+}
+
+impl Default for EstimatorConfig {
+    fn default() -> Self {
+        EstimatorConfig {
+            method: crate::service::estimator::Method::Kalman,
+            noise_m: 0.01,
+            noise_rad: 0.0005,
+            velocity_noise_m_s: 0.01,
+            velocity_noise_rad_s: 0.0005,
+            max_acceleration_g: 2.0,
+            gate_sigma: 5.0,
+            reset_samples: 5,
+            bias_time_s: 300.0,
         }
     }
 }
@@ -436,7 +478,7 @@ pub enum Error {
 /// `SHIPCAST_FORECAST__PERIOD_S=0.5`). `SHIPCAST_CONFIG` (the file's path, read by the CLI) and
 /// `SHIPCAST_LOG` are not keys and are left out.
 pub const ENV_PREFIX: &str = "SHIPCAST_";
-const ENV_NOT_KEYS: [&str; 2] = ["SHIPCAST_CONFIG", "SHIPCAST_LOG"];
+const ENV_NOT_KEYS: [&str; 3] = ["SHIPCAST_CONFIG", "SHIPCAST_LOG", crate::service::FAULT_ENV];
 
 /// Reads the file, overlays the `SHIPCAST_*` variables of `env` (name, value), validates. An error in
 /// the file names the file; an error an environment variable brings in names that variable.
@@ -591,7 +633,7 @@ pub const BOUNDS: &[Bound] = &[
     positive("forecast.max_wave_age_s", 3600.0, "s"),
     positive("forecast.suppress_wave_age_s", 3600.0, "s"),
     positive("forecast.max_motion_age_s", 3600.0, "s"),
-    // a bridged gap is a straight line through the motion: longer than a minute, it is invented
+    // a bridged gap is a curve through the motion at both ends: longer than a minute, it is invented
     positive("forecast.max_gap_s", 60.0, "s"),
     // samples kept beyond the memory: sizes the history (rate x time per vessel)
     closed("forecast.history_margin_s", 0.0, 3600.0, "s"),
@@ -604,6 +646,17 @@ pub const BOUNDS: &[Bound] = &[
     // how much faster than the daemon's a source's clock may run: a simulator at its speed
     closed("forecast.max_clock_rate", 1.0, 1000.0, ""),
     closed("forecast.max_dropped_wave_share", 0.0, 1.0, ""),
+    // a sensor's noise: beyond these it measures nothing of a ship's motion
+    positive("estimator.noise_m", 10.0, "m"),
+    positive("estimator.noise_rad", 1.0, "rad"),
+    positive("estimator.velocity_noise_m_s", 10.0, "m/s"),
+    positive("estimator.velocity_noise_rad_s", 1.0, "rad/s"),
+    // a tenth of g would refuse a ship's own motion in a storm; beyond 100 g is a crash, not a sea
+    closed("estimator.max_acceleration_g", 0.1, 100.0, "g"),
+    closed("estimator.gate_sigma", 1.0, 100.0, ""),
+    // refused samples in a row before a jump is believed: a few seconds of motion at 1000 Hz
+    closed("estimator.reset_samples", 1.0, 1000.0, ""),
+    positive("estimator.bias_time_s", DAY_S, "s"),
     // a terabyte of messages per file at most
     positive("record.rotate_mb", 1.0e6, "MB"),
     positive("record.rotate_s", 30.0 * DAY_S, "s"),
@@ -676,6 +729,14 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
             f.max_clock_rate,
         ),
         one("forecast.max_dropped_wave_share", f.max_dropped_wave_share),
+        one("estimator.noise_m", c.estimator.noise_m),
+        one("estimator.noise_rad", c.estimator.noise_rad),
+        one("estimator.velocity_noise_m_s", c.estimator.velocity_noise_m_s),
+        one("estimator.velocity_noise_rad_s", c.estimator.velocity_noise_rad_s),
+        one("estimator.max_acceleration_g", c.estimator.max_acceleration_g),
+        one("estimator.gate_sigma", c.estimator.gate_sigma),
+        one("estimator.reset_samples", c.estimator.reset_samples as f64),
+        one("estimator.bias_time_s", c.estimator.bias_time_s),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
         one("simulate.duration_s", s.duration_s),

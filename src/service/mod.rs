@@ -14,7 +14,7 @@
 
 pub mod clock;
 pub mod config;
-pub mod history;
+pub mod estimator;
 
 use crate::hydro::VesselSystem;
 use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
@@ -23,7 +23,7 @@ use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOption
 use crate::waves::field::{WaveField, heading_from_compass_deg};
 use crate::waves::horizon;
 use config::ShipcastConfig;
-use history::{Drop, History, Sample};
+use estimator::{Estimator, Refusal, Taken};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -172,15 +172,23 @@ impl Computer {
     }
 }
 
+/// `SHIPCAST_FAULT=compute-panic` makes the compute thread panic on its first job: fault injection for
+/// the test of the daemon's liveness (a panic there ends the daemon with an error).
+pub const FAULT_ENV: &str = "SHIPCAST_FAULT";
+
 fn compute_thread(
     mut computer: Computer,
     jobs: std::sync::mpsc::Receiver<Job>,
     done: tokio::sync::mpsc::Sender<Done>,
+    inject_panic: bool,
 ) -> std::thread::JoinHandle<()> {
     std::thread::Builder::new()
         .name("shipcast-compute".into())
         .spawn(move || {
             while let Ok(job) = jobs.recv() {
+                if inject_panic {
+                    panic!("{FAULT_ENV}=compute-panic: the compute thread panics on its first job");
+                }
                 let t = Instant::now();
                 let msg = computer.run(job, || t.elapsed().as_secs_f64() * 1e3);
                 if done.blocking_send(msg).is_err() {
@@ -205,6 +213,9 @@ pub struct Counters {
     pub future: u64,
     pub past: u64,
     pub clock_steps: u64,
+    /// Refused by the motion estimator as physically impossible, and its restarts after a real jump.
+    pub implausible: u64,
+    pub motion_restarts: u64,
 }
 
 /// Logs the first of a kind of event, then every time its count reaches a power of ten, so that a
@@ -259,6 +270,83 @@ fn judge(
     }
 }
 
+/// Flags of events, kept in the state until the next status reports them.
+const ONE_SHOT_FLAGS: u32 = flags::NUMERICAL | flags::CLOCK_STEP | flags::MOTION_IMPLAUSIBLE | flags::MOTION_RESTARTED;
+
+/// A refusal in words, with the DOF's name and units.
+fn refusal_text(why: &Refusal) -> String {
+    let name = |d: usize| crate::hydro::Dof::of_index(d).output_name();
+    let show = |d: usize, v: f64| crate::hydro::Dof::of_index(d).to_output(v);
+    match *why {
+        Refusal::Bound {
+            dof,
+            what,
+            value,
+            bound,
+        } => {
+            format!(
+                "{} {what} {:.4e} beyond +-{:.4e}",
+                name(dof),
+                show(dof, value),
+                show(dof, bound)
+            )
+        }
+        Refusal::Jump {
+            dof,
+            what,
+            change,
+            allowed,
+        } => format!(
+            "{} {what} changed by {:.4e} since the estimate, at most {:.4e} possible",
+            name(dof),
+            show(dof, change),
+            show(dof, allowed)
+        ),
+        Refusal::Frozen => "the same values as the sample before while the vessel moves (a stalled sensor)".into(),
+        Refusal::NonFinite | Refusal::Late | Refusal::Duplicate => format!("{why:?}"),
+    }
+}
+
+/// The estimator of vessel `b`: the configured sensor and gate, bounds from the body and the
+/// database, the bandwidth from the database's highest frequency, the bias on the DOFs with
+/// hydrostatic restoring.
+pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeModel, b: usize) -> estimator::Spec {
+    let e = &cfg.estimator;
+    let (omega_min, omega_max) = model.db.omega_range();
+    let mut spec = estimator::Spec {
+        method: e.method,
+        noise_x: [e.noise_m, e.noise_m, e.noise_m, e.noise_rad, e.noise_rad, e.noise_rad],
+        noise_v: [
+            e.velocity_noise_m_s,
+            e.velocity_noise_m_s,
+            e.velocity_noise_m_s,
+            e.velocity_noise_rad_s,
+            e.velocity_noise_rad_s,
+            e.velocity_noise_rad_s,
+        ],
+        q: [0.0; 6],
+        bounds: estimator::Bounds::from_system(
+            &sys.spec.bodies[b].mass,
+            sys.spec.g_m_s2,
+            e.max_acceleration_g,
+            omega_min,
+        ),
+        restored: [false; 6],
+        bias_time_s: e.bias_time_s,
+        gate_sigma: e.gate_sigma,
+        reset_samples: e.reset_samples as usize,
+    };
+    for d in 0..6 {
+        spec.q[d] = estimator::Spec::process_noise(spec.noise_x[d], estimator::BANDWIDTH_FACTOR * omega_max);
+        if (2..5).contains(&d)
+            && let Some(row) = model.active.iter().position(|&i| i == 6 * b + d)
+        {
+            spec.restored[d] = model.stiffness[(row, row)] > 0.0;
+        }
+    }
+    spec
+}
+
 fn power_of_ten(mut n: u64) -> bool {
     while n >= 10 && n.is_multiple_of(10) {
         n /= 10;
@@ -277,7 +365,8 @@ pub struct Engine {
     n_active: usize,
     positions: Vec<[f64; 2]>,
     heading: f64,
-    hist: Vec<History>,
+    /// Each vessel's motion estimator (its kept window of samples).
+    hist: Vec<Estimator>,
     /// Clock time of each vessel's newest accepted sample.
     arrival: Vec<Option<f64>>,
     field: Option<WaveField>,
@@ -285,8 +374,6 @@ pub struct Engine {
     motion_clock: Vec<clock::SourceClock>,
     wave_clock: clock::SourceClock,
     clock_rules: clock::ClockRules,
-    /// Motion kept per vessel, s.
-    keep_s: f64,
     /// Share of the last forecast's wave variance outside the database.
     dropped_wave_share: f64,
     /// Whether the last tick could forecast (for the log line when that changes).
@@ -319,7 +406,9 @@ impl Engine {
             n_active: model.n(),
             positions,
             heading,
-            hist: (0..n_bodies).map(|_| History::new(keep_s)).collect(),
+            hist: (0..n_bodies)
+                .map(|b| Estimator::new(estimator_spec(cfg, sys, model, b), keep_s))
+                .collect(),
             arrival: vec![None; n_bodies],
             field: None,
             motion_clock: vec![clock::SourceClock::default(); n_bodies],
@@ -330,7 +419,6 @@ impl Engine {
                 resync_samples: cfg.forecast.clock_resync_samples,
                 max_rate: cfg.forecast.max_clock_rate.unwrap_or(cfg.simulate.speed).max(1.0),
             },
-            keep_s,
             dropped_wave_share: 0.0,
             forecasting: None,
             counters: Counters::default(),
@@ -387,34 +475,63 @@ impl Engine {
                     Some(false) => {}
                     Some(true) => {
                         self.state_flags |= flags::CLOCK_STEP;
-                        self.hist[b] = History::new(self.keep_s);
+                        self.hist[b].restart();
                     }
                 }
-                match self.hist[b].push(Sample {
-                    time_s: m.time_s,
-                    x: m.x,
-                    v: m.v,
-                }) {
-                    Ok(()) => self.arrival[b] = Some(clock_s),
-                    Err(Drop::NonFinite) => {
+                match self.hist[b].push(m.time_s, m.x, m.v) {
+                    Ok(taken) => {
+                        self.arrival[b] = Some(clock_s);
+                        if taken == Taken::Restarted {
+                            c.motion_restarts += 1;
+                            self.state_flags |= flags::MOTION_RESTARTED;
+                            tracing::warn!(
+                                vessel = b,
+                                "motion samples that agree with each other but not with the estimate: a real jump, the estimate restarts from them"
+                            );
+                        }
+                    }
+                    Err(Refusal::NonFinite) => {
                         c.nonfinite += 1;
                         log_count(
                             c.nonfinite,
                             &format!("vessel {b}: motion sample with a non-finite value refused"),
                         );
                     }
-                    Err(Drop::Late) => {
+                    Err(Refusal::Late) => {
                         c.late += 1;
                         log_count(
                             c.late,
                             &format!("vessel {b}: motion sample older than the newest refused"),
                         );
                     }
-                    Err(Drop::Duplicate) => c.duplicate += 1,
+                    Err(Refusal::Duplicate) => c.duplicate += 1,
+                    Err(why) => {
+                        c.implausible += 1;
+                        self.state_flags |= flags::MOTION_IMPLAUSIBLE;
+                        log_count(
+                            c.implausible,
+                            &format!(
+                                "vessel {b}: motion sample refused as physically impossible: {}",
+                                refusal_text(&why)
+                            ),
+                        );
+                    }
                 }
             }
             Input::Waves(f) => {
                 c.wave_fields += 1;
+                if f.components.len() > crate::ipc::wire::MAX_WAVE_COMPONENTS {
+                    c.rejected += 1;
+                    log_count(
+                        c.rejected,
+                        &format!(
+                            "wave field of {} components refused: more than {}",
+                            f.components.len(),
+                            crate::ipc::wire::MAX_WAVE_COMPONENTS
+                        ),
+                    );
+                    return;
+                }
                 let Some(stepped) = judge(&mut self.wave_clock, c, "wave field", f.time_s, clock_s, &rules) else {
                     return;
                 };
@@ -552,7 +669,7 @@ impl Engine {
                 });
             }
         }
-        self.state_flags = fl | (self.state_flags & (flags::NUMERICAL | flags::CLOCK_STEP));
+        self.state_flags = fl | (self.state_flags & ONE_SHOT_FLAGS);
         job
     }
 
@@ -616,16 +733,32 @@ impl Engine {
             dropped_rejected: c.rejected,
             clock_steps: c.clock_steps,
             dropped_wave_share: self.dropped_wave_share,
+            dropped_implausible: c.implausible,
+            motion_restarts: c.motion_restarts,
             running: running as u32,
             ..Status::default()
         };
         for (b, h) in self.hist.iter().enumerate() {
             s.motion_age_s[b] = self.arrival[b].map(|a| clock_s - a).unwrap_or(-1.0);
             s.motion_rate_hz[b] = h.rate_hz();
+            let bias = h.bias();
+            s.motion_bias[b] = [bias[2], bias[3], bias[4]];
         }
-        self.state_flags &= !(flags::NUMERICAL | flags::CLOCK_STEP);
+        self.state_flags &= !ONE_SHOT_FLAGS;
         s
     }
+}
+
+/// The daemon (and a replay of its log) forecasts at most [`MAX_VESSELS`] vessels: the forecast and
+/// status payloads carry no more.
+pub fn fits_the_wire(sys: &VesselSystem) -> Result<(), String> {
+    let n = sys.spec.bodies.len();
+    if n > MAX_VESSELS {
+        return Err(format!(
+            "the system file has {n} vessels: the daemon's forecasts and status carry at most {MAX_VESSELS}"
+        ));
+    }
+    Ok(())
 }
 
 /// The daemon pings systemd's watchdog once per forecast period: a `WatchdogSec` shorter than two periods
@@ -648,10 +781,8 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let mut watchdog_usec = 0u64;
     let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
     watchdog_fits(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6))?;
+    fits_the_wire(&sys)?;
     let n_bodies = sys.spec.bodies.len();
-    if n_bodies > MAX_VESSELS {
-        return Err(format!("{n_bodies} vessels: the wire format carries at most {MAX_VESSELS}").into());
-    }
     let t_build = Instant::now();
     let model = TimeModel::new(&sys, rom_options(&cfg))?;
     let mut engine = Engine::new(&cfg, &sys, &model);
@@ -677,7 +808,13 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     }
     let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
     let (done_tx, mut done_rx) = tokio::sync::mpsc::channel::<Done>(4);
-    let compute = compute_thread(Computer::new(model, n_bodies, cfg.forecast.horizon_s), job_rx, done_tx);
+    let inject_panic = std::env::var(FAULT_ENV).is_ok_and(|v| v == "compute-panic");
+    let compute = compute_thread(
+        Computer::new(model, n_bodies, cfg.forecast.horizon_s),
+        job_rx,
+        done_tx,
+        inject_panic,
+    );
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));

@@ -39,6 +39,8 @@ FLAGS = [
     "waves_dropped",
     "clock_step",
     "clocks_disagree",
+    "motion_implausible",
+    "motion_restarted",
 ]
 
 

@@ -1,0 +1,807 @@
+//! The motion state estimator (pure): a vessel's IMU samples in, the state at a forecast's start and
+//! the velocity history behind it out, with what is physically impossible kept out.
+//!
+//! Conventions (DESIGN.md section 1): DOFs surge, sway, heave (m), roll, pitch, yaw (rad) about the
+//! body's reference point; velocities in m/s and rad/s; times are the samples' stamps, s.
+//!
+//! The choice, and why:
+//! - One Kalman filter per DOF on a kinematic process, state (displacement, velocity), driven by
+//!   white acceleration (the "nearly constant velocity" model), measuring both displacement and
+//!   velocity, as a motion reference unit reports them. A kinematic process needs no knowledge of the
+//!   waves: the excitation is what the forecast is for, and a model-based process would need it to
+//!   predict. The acceleration's spectral density is set from the measurement noise so that the
+//!   filter passes the whole band of the database (its bandwidth `BANDWIDTH_FACTOR` times the
+//!   database's highest frequency): the estimate follows the wave motion and takes noise out above it.
+//! - A Rauch-Tung-Striebel smoother over the kept window: the history the radiation memory reads uses
+//!   the samples after each one as well as before. Between samples, and across a gap up to
+//!   `forecast.max_gap_s`, the state is the cubic Hermite curve through the smoothed displacements
+//!   and velocities at both ends (the smoother's mean of this process between two known states),
+//!   its velocity that curve's slope.
+//! - Physically impossible samples are refused before they reach the filter: a displacement, velocity
+//!   or acceleration beyond bounds from the system (`Bounds::from_system`), or a change since the last
+//!   estimate that no acceleration within the bound could make over the time between them (beyond
+//!   `gate_sigma` standard deviations of the noise and the estimate's own uncertainty). A refused
+//!   sample never enters the filter, the smoother or the radiation history.
+//! - A real jump (a sensor re-zeroed) is told from a spike by persistence: `reset_samples` refused
+//!   samples in a row that agree with each other restart the estimate from them.
+//! - Sensor bias: the displacement of a DOF with hydrostatic restoring (heave, roll, pitch) has zero
+//!   mean about the equilibrium in linear waves, so its long average (time constant `bias_time_s`) is
+//!   the sensor's bias (or a static heel or trim: the two cannot be told apart from the motion alone;
+//!   the status reports the estimate). It is taken off the initial displacement once it has averaged
+//!   over a fifth of that time. The velocity history is not affected by a constant bias. DOFs without
+//!   restoring have no observable bias.
+
+use std::collections::VecDeque;
+
+/// The filter passes motion up to this many times the database's highest frequency.
+pub const BANDWIDTH_FACTOR: f64 = 4.0;
+
+/// How a vessel's samples become its state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The Kalman filter and smoother with gating and bias (the default).
+    Kalman,
+    /// The samples as they come, resampled linearly (no gating, no bias): for comparison.
+    Raw,
+}
+
+/// Per-DOF physical bounds of a vessel's motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    pub max_x: [f64; 6],
+    pub max_v: [f64; 6],
+    pub max_a: [f64; 6],
+}
+
+impl Bounds {
+    /// Bounds from the system: translations accelerate at most `max_acceleration_g` g; rotations at
+    /// most that over the body's radius of gyration about the axis (at least 1 m); no motion is slower
+    /// than the database's lowest frequency `omega_min_rad_s`, so velocity and displacement are bounded
+    /// by the acceleration over it and its square; roll and pitch never beyond 90 deg, yaw 180 deg.
+    pub fn from_system(
+        mass: &nalgebra::Matrix6<f64>,
+        g_m_s2: f64,
+        max_acceleration_g: f64,
+        omega_min_rad_s: f64,
+    ) -> Bounds {
+        let a_t = max_acceleration_g * g_m_s2;
+        let m = mass[(0, 0)].max(f64::MIN_POSITIVE);
+        let w = omega_min_rad_s.max(1e-3);
+        let mut b = Bounds {
+            max_x: [0.0; 6],
+            max_v: [0.0; 6],
+            max_a: [0.0; 6],
+        };
+        for d in 0..6 {
+            let a = if d < 3 {
+                a_t
+            } else {
+                let r_m = (mass[(d, d)] / m).sqrt();
+                a_t / if r_m.is_finite() { r_m.max(1.0) } else { 1.0 }
+            };
+            b.max_a[d] = a;
+            b.max_v[d] = a / w;
+            b.max_x[d] = a / (w * w);
+        }
+        b.max_x[3] = b.max_x[3].min(std::f64::consts::FRAC_PI_2);
+        b.max_x[4] = b.max_x[4].min(std::f64::consts::FRAC_PI_2);
+        b.max_x[5] = b.max_x[5].min(std::f64::consts::PI);
+        b
+    }
+}
+
+/// Everything the estimator of one vessel is set with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spec {
+    pub method: Method,
+    /// Measurement noise (standard deviation) per DOF: displacement (m, rad), velocity (m/s, rad/s).
+    pub noise_x: [f64; 6],
+    pub noise_v: [f64; 6],
+    /// Spectral density of the process's acceleration per DOF, m^2/s^3 (rad^2/s^3).
+    pub q: [f64; 6],
+    pub bounds: Bounds,
+    /// DOFs whose bias is estimated (hydrostatic restoring).
+    pub restored: [bool; 6],
+    pub bias_time_s: f64,
+    pub gate_sigma: f64,
+    pub reset_samples: usize,
+}
+
+impl Spec {
+    /// The process noise that gives a filter of bandwidth `bandwidth_rad_s` on displacement noise
+    /// `noise_x` (the white-acceleration filter's bandwidth is (q / r)^(1/4)).
+    pub fn process_noise(noise_x: f64, bandwidth_rad_s: f64) -> f64 {
+        bandwidth_rad_s.powi(4) * noise_x.max(1e-9).powi(2)
+    }
+}
+
+/// Why a sample was refused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Refusal {
+    NonFinite,
+    Late,
+    Duplicate,
+    /// The same values as the sample before, while the vessel was moving: a stalled sensor repeating
+    /// its last output (or zeros, an empty field read as 0).
+    Frozen,
+    /// Beyond a bound: the DOF, what (displacement, velocity), the value and the bound.
+    Bound {
+        dof: usize,
+        what: &'static str,
+        value: f64,
+        bound: f64,
+    },
+    /// A change since the last estimate no allowed acceleration makes: the DOF, what, the change and
+    /// the largest allowed.
+    Jump {
+        dof: usize,
+        what: &'static str,
+        change: f64,
+        allowed: f64,
+    },
+}
+
+/// What became of a sample that was taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Taken {
+    Accepted,
+    /// The estimate restarted from a run of refused samples that agree (a real jump).
+    Restarted,
+}
+
+/// One DOF's Gaussian: mean (displacement, velocity) and covariance (pp, pv, vv).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Gauss {
+    m: [f64; 2],
+    p: [f64; 3],
+}
+
+impl Gauss {
+    fn predict(&self, dt: f64, q: f64) -> Gauss {
+        let [pp, pv, vv] = self.p;
+        Gauss {
+            m: [self.m[0] + dt * self.m[1], self.m[1]],
+            p: [
+                pp + 2.0 * dt * pv + dt * dt * vv + q * dt.powi(3) / 3.0,
+                pv + dt * vv + q * dt * dt / 2.0,
+                vv + q * dt,
+            ],
+        }
+    }
+
+    /// The update with a measurement of both (variances rx, rv).
+    fn update(&self, z: [f64; 2], rx: f64, rv: f64) -> Gauss {
+        let [pp, pv, vv] = self.p;
+        let (s00, s01, s11) = (pp + rx, pv, vv + rv);
+        let det = s00 * s11 - s01 * s01;
+        // K = P S^-1
+        let (i00, i01, i11) = (s11 / det, -s01 / det, s00 / det);
+        let k00 = pp * i00 + pv * i01;
+        let k01 = pp * i01 + pv * i11;
+        let k10 = pv * i00 + vv * i01;
+        let k11 = pv * i01 + vv * i11;
+        let (n0, n1) = (z[0] - self.m[0], z[1] - self.m[1]);
+        // P - K P (symmetric up to rounding: the symmetric part kept)
+        let q00 = pp - (k00 * pp + k01 * pv);
+        let q01 = pv - 0.5 * ((k00 * pv + k01 * vv) + (k10 * pp + k11 * pv));
+        let q11 = vv - (k10 * pv + k11 * vv);
+        Gauss {
+            m: [self.m[0] + k00 * n0 + k01 * n1, self.m[1] + k10 * n0 + k11 * n1],
+            p: [q00.max(0.0), q01, q11.max(0.0)],
+        }
+    }
+}
+
+/// One sample the filter took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Entry {
+    time_s: f64,
+    /// The measurement (for the raw method and the bias).
+    x: [f64; 6],
+    v: [f64; 6],
+    /// Filtered, and predicted from the entry before (the smoother's inputs).
+    filtered: [Gauss; 6],
+    predicted: [Gauss; 6],
+}
+
+/// The state at a forecast's start and the velocities before it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resampled {
+    pub x0: [f64; 6],
+    pub v0: [f64; 6],
+    /// Velocities at t0 - n dt .. t0 - dt (oldest first).
+    pub velocities: Vec<[f64; 6]>,
+    /// Part of the requested history was not there (taken as at rest).
+    pub short: bool,
+    /// A gap was bridged.
+    pub gap: bool,
+}
+
+/// Running mean of a restored DOF's displacement: the bias.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Bias {
+    value: [f64; 6],
+    span_s: f64,
+}
+
+/// A vessel's estimator: the kept window of filtered samples, the bias, and a run of refused samples
+/// that may turn out to be a real jump.
+#[derive(Debug, Clone)]
+pub struct Estimator {
+    spec: Spec,
+    keep_s: f64,
+    entries: VecDeque<Entry>,
+    bias: Bias,
+    /// Refused samples in a row that agree with each other, filtered from the first of them.
+    candidate: Vec<Entry>,
+    /// The values of the last sample received (taken or not).
+    last_received: Option<([f64; 6], [f64; 6])>,
+}
+
+impl Estimator {
+    /// Keeps samples spanning `keep_s` seconds behind the newest.
+    pub fn new(spec: Spec, keep_s: f64) -> Estimator {
+        Estimator {
+            spec,
+            keep_s,
+            entries: VecDeque::new(),
+            bias: Bias::default(),
+            candidate: vec![],
+            last_received: None,
+        }
+    }
+
+    /// Forgets every sample (a step of the source's clock): the bias is the sensor's and stays.
+    pub fn restart(&mut self) {
+        self.entries.clear();
+        self.candidate.clear();
+    }
+
+    pub fn newest_time_s(&self) -> Option<f64> {
+        self.entries.back().map(|e| e.time_s)
+    }
+
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Sample rate over the kept samples, Hz.
+    pub fn rate_hz(&self) -> f64 {
+        match (self.entries.front(), self.entries.back()) {
+            (Some(a), Some(b)) if b.time_s > a.time_s => (self.entries.len() - 1) as f64 / (b.time_s - a.time_s),
+            _ => 0.0,
+        }
+    }
+
+    /// The bias estimate taken off the initial displacement (0 for DOFs without restoring, and until
+    /// the average spans a fifth of `bias_time_s`).
+    pub fn bias(&self) -> [f64; 6] {
+        if self.spec.method == Method::Raw || self.bias.span_s < 0.2 * self.spec.bias_time_s {
+            return [0.0; 6];
+        }
+        let mut b = self.bias.value;
+        for (d, bd) in b.iter_mut().enumerate() {
+            if !self.spec.restored[d] {
+                *bd = 0.0;
+            }
+        }
+        b
+    }
+
+    fn first(&self, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Entry {
+        let mut g = [Gauss::default(); 6];
+        for d in 0..6 {
+            g[d] = Gauss {
+                m: [x[d], v[d]],
+                p: [self.spec.noise_x[d].powi(2), 0.0, self.spec.noise_v[d].powi(2)],
+            };
+        }
+        Entry {
+            time_s,
+            x,
+            v,
+            filtered: g,
+            predicted: g,
+        }
+    }
+
+    /// The sample filtered after `prev`, or why it cannot follow it.
+    fn follow(&self, prev: &Entry, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Result<Entry, Refusal> {
+        let s = &self.spec;
+        let dt = time_s - prev.time_s;
+        let mut e = Entry {
+            time_s,
+            x,
+            v,
+            filtered: [Gauss::default(); 6],
+            predicted: [Gauss::default(); 6],
+        };
+        for d in 0..6 {
+            let pred = prev.filtered[d].predict(dt, s.q[d]);
+            let (rx, rv) = (s.noise_x[d].powi(2), s.noise_v[d].powi(2));
+            if s.method == Method::Kalman {
+                let a = s.bounds.max_a[d];
+                let allowed_x = 0.5 * a * dt * dt + s.gate_sigma * (pred.p[0] + rx).sqrt();
+                let allowed_v = a * dt + s.gate_sigma * (pred.p[2] + rv).sqrt();
+                let (cx, cv) = ((x[d] - pred.m[0]).abs(), (v[d] - pred.m[1]).abs());
+                if cx > allowed_x {
+                    return Err(Refusal::Jump {
+                        dof: d,
+                        what: "displacement",
+                        change: cx,
+                        allowed: allowed_x,
+                    });
+                }
+                if cv > allowed_v {
+                    return Err(Refusal::Jump {
+                        dof: d,
+                        what: "velocity",
+                        change: cv,
+                        allowed: allowed_v,
+                    });
+                }
+            }
+            e.predicted[d] = pred;
+            e.filtered[d] = pred.update([x[d], v[d]], rx, rv);
+        }
+        Ok(e)
+    }
+
+    /// Takes one sample, or says why not.
+    pub fn push(&mut self, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Result<Taken, Refusal> {
+        if !(time_s.is_finite() && x.iter().chain(&v).all(|v| v.is_finite())) {
+            return Err(Refusal::NonFinite);
+        }
+        if let Some(last) = self.entries.back() {
+            if time_s == last.time_s {
+                return Err(Refusal::Duplicate);
+            }
+            if time_s < last.time_s {
+                return Err(Refusal::Late);
+            }
+        }
+        let repeated = self.last_received == Some((x, v));
+        self.last_received = Some((x, v));
+        if self.spec.method == Method::Kalman {
+            if repeated {
+                // a sensor's noise never repeats all its values: a repeat is a stalled sensor, unless
+                // the vessel has read the same from its first sample on (at rest, noise-free). The
+                // stall's first output, taken before it repeated, is taken back.
+                let same = |e: &Entry| e.x == x && e.v == v;
+                let n = self.entries.len();
+                let at_rest_from_start = self.entries.iter().all(same);
+                if !at_rest_from_start {
+                    if n >= 2 && same(&self.entries[n - 1]) {
+                        self.entries.pop_back();
+                    }
+                    return Err(Refusal::Frozen);
+                }
+            }
+            let b = &self.spec.bounds;
+            for d in 0..6 {
+                if x[d].abs() > b.max_x[d] {
+                    return Err(Refusal::Bound {
+                        dof: d,
+                        what: "displacement",
+                        value: x[d],
+                        bound: b.max_x[d],
+                    });
+                }
+                if v[d].abs() > b.max_v[d] {
+                    return Err(Refusal::Bound {
+                        dof: d,
+                        what: "velocity",
+                        value: v[d],
+                        bound: b.max_v[d],
+                    });
+                }
+            }
+        }
+        let entry = match self.entries.back() {
+            None => self.first(time_s, x, v),
+            Some(prev) => match self.follow(prev, time_s, x, v) {
+                Ok(e) => e,
+                Err(why) => return self.refused(why, time_s, x, v),
+            },
+        };
+        self.candidate.clear();
+        self.take(entry);
+        Ok(Taken::Accepted)
+    }
+
+    /// A sample refused by the gate: kept as a candidate jump; `reset_samples` in a row that agree
+    /// restart the estimate from them.
+    fn refused(&mut self, why: Refusal, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Result<Taken, Refusal> {
+        let next = match self.candidate.last() {
+            Some(prev) if time_s > prev.time_s => self.follow(prev, time_s, x, v).ok(),
+            _ => None,
+        };
+        match next {
+            Some(e) => self.candidate.push(e),
+            None => self.candidate = vec![self.first(time_s, x, v)],
+        }
+        if self.candidate.len() < self.spec.reset_samples.max(1) {
+            return Err(why);
+        }
+        self.entries.clear();
+        self.bias = Bias::default();
+        for e in std::mem::take(&mut self.candidate) {
+            self.take(e);
+        }
+        Ok(Taken::Restarted)
+    }
+
+    fn take(&mut self, e: Entry) {
+        if let Some(prev) = self.entries.back() {
+            let dt = e.time_s - prev.time_s;
+            self.bias.span_s += dt;
+            let w = (dt / self.spec.bias_time_s.min(self.bias.span_s)).min(1.0);
+            for d in 0..6 {
+                self.bias.value[d] += w * (e.x[d] - self.bias.value[d]);
+            }
+        } else if self.bias.span_s == 0.0 {
+            self.bias.value = e.x;
+        }
+        let t = e.time_s;
+        self.entries.push_back(e);
+        while let Some(f) = self.entries.front() {
+            if t - f.time_s > self.keep_s && self.entries.len() > 2 {
+                self.entries.pop_front();
+            } else {
+                break;
+            }
+        }
+    }
+
+    /// Displacements and velocities at the kept samples: smoothed (Kalman), or as measured (raw).
+    fn smoothed(&self) -> Vec<(f64, [f64; 6], [f64; 6])> {
+        let n = self.entries.len();
+        let mut out: Vec<(f64, [f64; 6], [f64; 6])> = self.entries.iter().map(|e| (e.time_s, e.x, e.v)).collect();
+        if self.spec.method == Method::Raw || n == 0 {
+            return out;
+        }
+        for d in 0..6 {
+            let last = &self.entries[n - 1].filtered[d];
+            let mut ms = last.m;
+            out[n - 1].1[d] = ms[0];
+            out[n - 1].2[d] = ms[1];
+            for k in (0..n - 1).rev() {
+                let f = &self.entries[k].filtered[d];
+                let next = &self.entries[k + 1];
+                let pr = &next.predicted[d];
+                let dt = next.time_s - self.entries[k].time_s;
+                // C = P_k Phi^T Ppred^-1, Phi = [[1, dt], [0, 1]]
+                let [pp, pv, vv] = f.p;
+                let (a00, a01, a10, a11) = (pp + dt * pv, pv, pv + dt * vv, vv);
+                let [qp, qpv, qv] = pr.p;
+                let det = qp * qv - qpv * qpv;
+                if !(det.is_finite() && det > 0.0) {
+                    ms = f.m;
+                } else {
+                    let (i00, i01, i11) = (qv / det, -qpv / det, qp / det);
+                    let c00 = a00 * i00 + a01 * i01;
+                    let c01 = a00 * i01 + a01 * i11;
+                    let c10 = a10 * i00 + a11 * i01;
+                    let c11 = a10 * i01 + a11 * i11;
+                    let (r0, r1) = (ms[0] - pr.m[0], ms[1] - pr.m[1]);
+                    ms = [f.m[0] + c00 * r0 + c01 * r1, f.m[1] + c10 * r0 + c11 * r1];
+                }
+                out[k].1[d] = ms[0];
+                out[k].2[d] = ms[1];
+            }
+        }
+        out
+    }
+
+    /// The state at `t0_s` and the `n` velocities before it at step `dt_s`; walking back from t0, a gap
+    /// up to `max_gap_s` is bridged (and flagged), a longer one ends the history: what is before it
+    /// counts as at rest (flagged short). None if t0 is after the newest sample or fewer than two are
+    /// kept. The bias is taken off the initial displacement.
+    pub fn resample(&self, t0_s: f64, dt_s: f64, n: usize, max_gap_s: f64) -> Option<Resampled> {
+        let last = self.entries.back()?;
+        if t0_s > last.time_s + 1e-9 || self.entries.len() < 2 {
+            return None;
+        }
+        let pts = self.smoothed();
+        let hermite = self.spec.method == Method::Kalman;
+        let nominal = {
+            let r = self.rate_hz();
+            if r > 0.0 { 1.0 / r } else { f64::INFINITY }
+        };
+        let mut out = Resampled {
+            x0: [0.0; 6],
+            v0: [0.0; 6],
+            velocities: vec![[0.0; 6]; n],
+            short: false,
+            gap: false,
+        };
+        let mut j = pts.len() - 1;
+        let mut ended = false;
+        // the state at t, or None where the history has ended
+        let mut at = |t: f64, out: &mut Resampled| -> Option<([f64; 6], [f64; 6])> {
+            if ended {
+                out.short = true;
+                return None;
+            }
+            while j > 0 && pts[j].0 > t {
+                j -= 1;
+            }
+            let a = pts[j];
+            if a.0 > t {
+                ended = true;
+                out.short = true;
+                return None;
+            }
+            let b = if j + 1 < pts.len() { pts[j + 1] } else { a };
+            let h = b.0 - a.0;
+            if h > max_gap_s {
+                ended = true;
+                out.short = true;
+                return None;
+            }
+            if h > 2.5 * nominal {
+                out.gap = true;
+            }
+            let s = if h > 0.0 { (t - a.0) / h } else { 0.0 };
+            let (mut x, mut v) = ([0.0; 6], [0.0; 6]);
+            for d in 0..6 {
+                if hermite && h > 0.0 {
+                    let (s2, s3) = (s * s, s * s * s);
+                    x[d] = (2.0 * s3 - 3.0 * s2 + 1.0) * a.1[d]
+                        + (s3 - 2.0 * s2 + s) * h * a.2[d]
+                        + (-2.0 * s3 + 3.0 * s2) * b.1[d]
+                        + (s3 - s2) * h * b.2[d];
+                    v[d] = ((6.0 * s2 - 6.0 * s) * (a.1[d] - b.1[d])) / h
+                        + (3.0 * s2 - 4.0 * s + 1.0) * a.2[d]
+                        + (3.0 * s2 - 2.0 * s) * b.2[d];
+                } else {
+                    x[d] = a.1[d] + s * (b.1[d] - a.1[d]);
+                    v[d] = a.2[d] + s * (b.2[d] - a.2[d]);
+                }
+            }
+            Some((x, v))
+        };
+        if let Some((x, v)) = at(t0_s, &mut out) {
+            let bias = self.bias();
+            for d in 0..6 {
+                out.x0[d] = x[d] - bias[d];
+            }
+            out.v0 = v;
+        }
+        for m in 1..=n {
+            if let Some((_, v)) = at(t0_s - m as f64 * dt_s, &mut out) {
+                out.velocities[n - m] = v;
+            }
+        }
+        Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(method: Method) -> Spec {
+        let noise_x = [0.01, 0.01, 0.01, 5e-4, 5e-4, 5e-4];
+        let mut q = [0.0; 6];
+        for d in 0..6 {
+            q[d] = Spec::process_noise(noise_x[d], 10.0);
+        }
+        Spec {
+            method,
+            noise_x,
+            noise_v: noise_x,
+            q,
+            bounds: Bounds::from_system(&nalgebra::Matrix6::from_diagonal_element(1e6), 9.81, 2.0, 0.2),
+            restored: [false, false, true, true, true, false],
+            bias_time_s: 100.0,
+            gate_sigma: 5.0,
+            reset_samples: 5,
+        }
+    }
+
+    /// A heave of 1 m at 0.6 rad/s sampled at 10 Hz with a 0.2 m bias (no noise).
+    fn wave(t: f64) -> ([f64; 6], [f64; 6]) {
+        let w = 0.6;
+        let mut x = [0.0; 6];
+        let mut v = [0.0; 6];
+        x[2] = (w * t).sin() + 0.2;
+        v[2] = w * (w * t).cos();
+        (x, v)
+    }
+
+    fn fed(method: Method, until_s: f64, skip: impl Fn(f64) -> bool) -> Estimator {
+        let mut e = Estimator::new(spec(method), 300.0);
+        for k in 0..=(until_s * 10.0) as usize {
+            let t = k as f64 * 0.1;
+            if skip(t) {
+                continue;
+            }
+            let (x, v) = wave(t);
+            e.push(t, x, v).unwrap();
+        }
+        e
+    }
+
+    #[test]
+    fn the_state_follows_the_motion_and_the_bias_comes_off() {
+        let e = fed(Method::Kalman, 200.0, |_| false);
+        let r = e.resample(200.0, 0.1, 100, 1.0).unwrap();
+        let truth = (0.6f64 * 200.0).sin();
+        assert!((r.x0[2] - truth).abs() < 0.02, "{} against {truth}", r.x0[2]);
+        assert!((e.bias()[2] - 0.2).abs() < 0.02, "bias {}", e.bias()[2]);
+        assert!(!r.short && !r.gap);
+        // the raw method keeps the bias
+        let raw = fed(Method::Raw, 200.0, |_| false)
+            .resample(200.0, 0.1, 100, 1.0)
+            .unwrap();
+        assert!((raw.x0[2] - truth - 0.2).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_gap_is_bridged_by_the_curve_through_both_ends() {
+        // 1.9 s without samples before t0 = 100
+        let e = fed(Method::Kalman, 100.0, |t| t > 98.05 && t < 99.95);
+        let r = e.resample(99.0, 0.1, 10, 2.0).unwrap();
+        let (x, v) = wave(99.0);
+        assert!(
+            (r.x0[2] + e.bias()[2] - x[2]).abs() < 0.01,
+            "{} against {}",
+            r.x0[2],
+            x[2]
+        );
+        let (_, v_before) = wave(98.5);
+        assert!((r.velocities[5][2] - v_before[2]).abs() < 0.01);
+        assert!((r.v0[2] - v[2]).abs() < 0.01);
+        assert!(r.gap && !r.short);
+        // linear (raw) across the same gap is far off
+        let raw = fed(Method::Raw, 100.0, |t| t > 98.05 && t < 99.95)
+            .resample(99.0, 0.1, 10, 2.0)
+            .unwrap();
+        assert!((raw.v0[2] - v[2]).abs() > 0.05);
+    }
+
+    #[test]
+    fn a_spike_is_refused_and_a_real_jump_restarts_the_estimate() {
+        let mut e = fed(Method::Kalman, 50.0, |_| false);
+        let (mut x, v) = wave(50.1);
+        x[2] += 1e6;
+        assert!(matches!(e.push(50.1, x, v), Err(Refusal::Bound { dof: 2, .. })));
+        x[2] -= 1e6 - 1.0; // a metre off: within the bounds, not within reach in 0.1 s
+        assert!(matches!(e.push(50.1, x, v), Err(Refusal::Jump { dof: 2, .. })));
+        let (x, v) = wave(50.2);
+        assert_eq!(e.push(50.2, x, v), Ok(Taken::Accepted));
+        // a sensor re-zeroed 10 m away (further than 2 g moves it in half a second): refused four
+        // times, then taken
+        for k in 3..8 {
+            let t = 50.0 + k as f64 * 0.1;
+            let (mut x, v) = wave(t);
+            x[2] += 10.0;
+            let got = e.push(t, x, v);
+            if k < 7 {
+                assert!(matches!(got, Err(Refusal::Jump { .. })), "{k}: {got:?}");
+            } else {
+                assert_eq!(got, Ok(Taken::Restarted));
+            }
+        }
+        assert_eq!(e.len(), 5);
+    }
+
+    #[test]
+    fn the_smoother_takes_noise_out_of_the_displacement() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut e = Estimator::new(spec(Method::Kalman), 300.0);
+        let mut raw = Estimator::new(spec(Method::Raw), 300.0);
+        for k in 0..=600 {
+            let t = k as f64 * 0.1;
+            let (mut x, mut v) = wave(t);
+            x[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            v[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            e.push(t, x, v).unwrap();
+            raw.push(t, x, v).unwrap();
+        }
+        // displacements at the samples and velocities on the grid, against the truth
+        let err = |est: &Estimator| {
+            let r = est.resample(60.0, 0.1, 500, 1.0).unwrap();
+            let v = (0..500)
+                .map(|m| (r.velocities[m][2] - wave(60.0 - (500 - m) as f64 * 0.1).1[2]).powi(2))
+                .sum::<f64>();
+            let x = est
+                .smoothed()
+                .iter()
+                .map(|(t, x, _)| (x[2] - wave(*t).0[2]).powi(2))
+                .sum::<f64>();
+            ((x / est.len() as f64).sqrt(), (v / 500.0).sqrt())
+        };
+        let (kalman, measured) = (err(&e), err(&raw));
+        assert!(
+            kalman.0 < 0.6 * measured.0,
+            "displacement error {} smoothed, {} as measured",
+            kalman.0,
+            measured.0
+        );
+        assert!(
+            kalman.1 <= measured.1,
+            "velocity error {} smoothed, {} as measured",
+            kalman.1,
+            measured.1
+        );
+    }
+
+    #[test]
+    fn a_stalled_sensor_repeating_itself_is_refused_and_bridged() {
+        let mut e = fed(Method::Kalman, 50.0, |_| false);
+        // zeros for 1.9 s: the first is a jump, the rest repeat it
+        for k in 1..20 {
+            let t = 50.0 + 0.1 * k as f64;
+            let got = e.push(t, [0.0; 6], [0.0; 6]);
+            assert!(
+                matches!(got, Err(Refusal::Jump { .. } | Refusal::Frozen)),
+                "{k}: {got:?}"
+            );
+        }
+        let (x, v) = wave(52.0);
+        assert_eq!(e.push(52.0, x, v), Ok(Taken::Accepted));
+        let r = e.resample(51.0, 0.1, 5, 2.0).unwrap();
+        assert!((r.x0[2] + e.bias()[2] - wave(51.0).0[2]).abs() < 0.01, "{}", r.x0[2]);
+        // a small motion: the stall's first zero is within reach and taken, then taken back
+        let mut e = Estimator::new(spec(Method::Kalman), 300.0);
+        for k in 0..=500 {
+            let t = k as f64 * 0.1;
+            let (mut x, mut v) = wave(t);
+            x[2] = 0.05 * (x[2] - 0.2);
+            v[2] *= 0.05;
+            e.push(t, x, v).unwrap();
+        }
+        assert_eq!(e.push(50.1, [0.0; 6], [0.0; 6]), Ok(Taken::Accepted));
+        assert_eq!(e.push(50.2, [0.0; 6], [0.0; 6]), Err(Refusal::Frozen));
+        assert_eq!(e.newest_time_s(), Some(50.0));
+        // a vessel at rest, measured so, is not frozen
+        let mut rest = Estimator::new(spec(Method::Kalman), 300.0);
+        for k in 0..10 {
+            assert_eq!(rest.push(k as f64 * 0.1, [0.0; 6], [0.0; 6]), Ok(Taken::Accepted));
+        }
+    }
+
+    #[test]
+    fn drops_are_counted_by_kind_and_raw_resampling_is_linear_with_the_gap_rule() {
+        let s = |t: f64, v: f64| (t, [v; 6], [v; 6]);
+        let mut h = Estimator::new(spec(Method::Raw), 100.0);
+        let (t, x, v) = s(1.0, 0.0);
+        assert!(h.push(t, x, v).is_ok());
+        assert_eq!(h.push(t, x, v), Err(Refusal::Duplicate));
+        assert_eq!(h.push(0.5, x, v), Err(Refusal::Late));
+        assert_eq!(h.push(2.0, [f64::NAN; 6], v), Err(Refusal::NonFinite));
+        assert_eq!(h.len(), 1);
+        let mut h = Estimator::new(spec(Method::Raw), 100.0);
+        for k in 0..=100 {
+            let t = k as f64 * 0.1;
+            if (40..60).contains(&k) {
+                continue; // a 2 s gap from 3.9 to 6.0
+            }
+            let (t, x, v) = s(t, t);
+            h.push(t, x, v).unwrap();
+        }
+        let r = h.resample(10.0, 0.25, 8, 3.0).unwrap();
+        assert!((r.x0[2] - 10.0).abs() < 1e-12 && (r.velocities[7][0] - 9.75).abs() < 1e-12);
+        assert!(!r.short && !r.gap);
+        // back across the gap: bridged with max_gap 3 s, ends the history with 1 s
+        let r = h.resample(10.0, 0.5, 16, 3.0).unwrap();
+        assert!(r.gap && !r.short);
+        assert!((r.velocities[0][0] - 2.0).abs() < 1e-12);
+        let r = h.resample(10.0, 0.5, 16, 1.0).unwrap();
+        assert!(r.short);
+        assert_eq!(r.velocities[0], [0.0; 6]);
+        // history longer than what is kept: short
+        let r = h.resample(10.0, 1.0, 20, 3.0).unwrap();
+        assert!(r.short);
+        // t0 after the newest sample: nothing
+        assert!(h.resample(10.5, 0.1, 5, 1.0).is_none());
+    }
+}
