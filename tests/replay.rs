@@ -91,11 +91,13 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
             &rep.join("skill.svg"),
             &[
                 "lead time (s)",
-                "correlation (forecast, measured)",
-                "NRMSE (RMS error / measured std)",
+                "correlation (forecast, truth)",
+                "NRMSE (RMS error / truth std)",
                 "carrier heave",
             ],
         );
+        // a simulation's forecasts are scored against its true motion
+        assert_eq!(j["reference"], "truth");
         // operator windows (default channels: heave 1 m, roll 2 deg) against the simulation's truth
         let w: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(rep.join("windows.json")).unwrap()).unwrap();

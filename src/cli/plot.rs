@@ -319,10 +319,12 @@ pub struct SkillCurve {
     pub nrmse: Vec<f64>,
 }
 
-type SkillPanel = (&'static str, String, f64, f64, fn(&SkillCurve) -> &Vec<f64>);
+type SkillPanel = (String, String, f64, f64, fn(&SkillCurve) -> &Vec<f64>);
 
 struct SkillFigure<'a> {
     title: String,
+    /// What the forecasts are scored against: `truth` or `measured`.
+    reference: &'a str,
     lead_s: &'a [f64],
     curves: &'a [SkillCurve],
 }
@@ -356,14 +358,14 @@ impl Figure for SkillFigure<'_> {
         // per panel: y label, caption, y range, the curve's values
         let panels: [SkillPanel; 2] = [
             (
-                "correlation (forecast, measured)",
-                "Correlation of forecast and measured motion".into(),
+                format!("correlation (forecast, {})", self.reference),
+                format!("Correlation of forecast and {} motion", self.reference),
                 c_lo,
                 1.02,
                 |c| &c.correlation,
             ),
             (
-                "NRMSE (RMS error / measured std)",
+                format!("NRMSE (RMS error / {} std)", self.reference),
                 if clipped {
                     format!(
                         "Normalized RMS error (clipped at {NRMSE_CLIP}: the largest is {n_max:.1}, drawn at {NRMSE_CLIP})"
@@ -433,9 +435,10 @@ impl Figure for SkillFigure<'_> {
 
 /// Writes the skill of `curves` against lead time (`lead_s`, s) over `forecasts` forecasts as `svg`
 /// and the PNG beside it: correlation above, NRMSE below, a shared legend right of both.
-pub fn skill(svg: &Path, forecasts: usize, lead_s: &[f64], curves: &[SkillCurve]) -> Result<()> {
+pub fn skill(svg: &Path, forecasts: usize, reference: &str, lead_s: &[f64], curves: &[SkillCurve]) -> Result<()> {
     let fig = SkillFigure {
-        title: format!("Forecast skill against lead time: {forecasts} forecasts against the measured motion"),
+        title: format!("Forecast skill against lead time: {forecasts} forecasts against the {reference} motion"),
+        reference,
         lead_s,
         curves,
     };
@@ -540,7 +543,7 @@ mod tests {
                 nrmse: lead.iter().map(|l| if *l > 60.0 { 5.0 } else { f64::NAN }).collect(),
             },
         ];
-        skill(&svg, 42, &lead, &curves).unwrap();
+        skill(&svg, 42, "measured", &lead, &curves).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         for s in [
             "Forecast skill against lead time: 42 forecasts",

@@ -176,17 +176,18 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
     }
     if let Some(dir) = &a.report {
-        report(dir, &sys, &log.records, &forecasts, cfg.forecast.horizon_s)?;
         let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
-        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
-        // windows are scored against the true motion when the log has it (a simulation), else the
-        // measured: IMU noise near a limit breaks windows that the motion itself kept
+        // forecasts are scored against the true motion when the log has it (a simulation), else the
+        // measured: the sensor's noise and bias are not the vessel's motion, and IMU noise near a
+        // limit breaks windows that the motion itself kept
         let truth = measured_series(&log.records, vessels.len(), true);
         let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
             (truth, "truth")
         } else {
             (measured_series(&log.records, vessels.len(), false), "measured")
         };
+        report(dir, &sys, &measured, reference, &forecasts, cfg.forecast.horizon_s)?;
+        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
         windows_report(
             dir,
             &sys,
@@ -446,17 +447,18 @@ fn forecast_plot(
     plot::forecast(svg, f.issue_time_s - log_start_s, reference, span, &panels)
 }
 
-/// Skill of every vessel DOF against lead time, against the measured motion in the log.
+/// Skill of every vessel DOF against lead time, against `measured_all` (every series, 6 per vessel:
+/// the true motion of a simulation, or the measured), named by `reference`.
 fn report(
     dir: &Path,
     sys: &shipcast::hydro::VesselSystem,
-    records: &[(f64, Record)],
+    measured_all: &[Vec<(f64, f64)>],
+    reference: &str,
     forecasts: &[ForecastRecord],
     horizon_s: f64,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let nb = sys.spec.bodies.len();
-    let measured_all = measured_series(records, nb, false);
     let step = 5.0;
     let mut json_vessels = vec![];
     let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,count\n");
@@ -521,17 +523,17 @@ fn report(
     std::fs::write(
         dir.join("skill.json"),
         format!(
-            "{{\"lead_s\":[{lead_json}],\"forecasts\":{},\"vessels\":{{{}}}}}\n",
+            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"vessels\":{{{}}}}}\n",
             forecasts.len(),
             json_vessels.join(",")
         ),
     )?;
     std::fs::write(dir.join("skill.csv"), csv)?;
-    plot::skill(&dir.join("skill.svg"), forecasts.len(), &lead, &curves)?;
+    plot::skill(&dir.join("skill.svg"), forecasts.len(), reference, &lead, &curves)?;
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
-        "report: {}/skill.json, skill.csv, skill.svg, skill.png",
+        "report (against the {reference} motion): {}/skill.json, skill.csv, skill.svg, skill.png",
         dir.display()
     )?;
     Ok(())
