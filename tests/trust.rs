@@ -488,6 +488,8 @@ enum Fault {
     Spike(f64),
     /// The sensor stalled: this and the next records of the vessel repeat zeros.
     Zeros,
+    /// This and the next 29 motion records lost (3 s at 10 Hz).
+    Gap,
     /// The record sent twice.
     Duplicate,
     /// The record swapped with the next one (out of order).
@@ -516,6 +518,14 @@ fn apply(records: &mut Vec<(f64, Record)>, at: usize, fault: Fault) {
                 }
             }
         }
+        (Record::Motion(_), Fault::Gap) => {
+            let end = (at + 30).min(records.len() - 2);
+            let kept: Vec<(f64, Record)> = records
+                .drain(at..end)
+                .filter(|(_, r)| !matches!(r, Record::Motion(_)))
+                .collect();
+            records.splice(at..at, kept);
+        }
         (Record::Waves(w), Fault::NanValue) => w.components.iter_mut().for_each(|c| c[2] = f64::NAN),
         (Record::Waves(w), Fault::NanStamp) => w.time_s = f64::NAN,
         (Record::Waves(w), Fault::InfStamp) => w.time_s = f64::INFINITY,
@@ -540,6 +550,7 @@ fn fault() -> impl proptest::strategy::Strategy<Value = Fault> {
         prop_oneof![-1e9..-1.0f64, 1.0..1e9f64].prop_map(Fault::Stamp),
         prop_oneof![Just(1e6), Just(-1e6), Just(1e300)].prop_map(Fault::Spike),
         Just(Fault::Zeros),
+        Just(Fault::Gap),
         Just(Fault::Duplicate),
         Just(Fault::Swap),
         Just(Fault::EmptyField),

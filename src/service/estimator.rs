@@ -36,6 +36,10 @@ use std::collections::VecDeque;
 /// The filter passes motion up to this many times the database's highest frequency.
 pub const BANDWIDTH_FACTOR: f64 = 4.0;
 
+/// Samples closer than this to the newest taken are refused as duplicates: the kept window holds at
+/// most 1000 samples a second, whatever a sensor sends.
+pub const MIN_SAMPLE_INTERVAL_S: f64 = 1e-3;
+
 /// How a vessel's samples become its state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -121,6 +125,7 @@ impl Spec {
 pub enum Refusal {
     NonFinite,
     Late,
+    /// The same stamp as the newest taken, or less than [`MIN_SAMPLE_INTERVAL_S`] after it.
     Duplicate,
     /// The same values as the sample before, while the vessel was moving: a stalled sensor repeating
     /// its last output (or zeros, an empty field read as 0).
@@ -358,11 +363,11 @@ impl Estimator {
             return Err(Refusal::NonFinite);
         }
         if let Some(last) = self.entries.back() {
-            if time_s == last.time_s {
-                return Err(Refusal::Duplicate);
-            }
             if time_s < last.time_s {
                 return Err(Refusal::Late);
+            }
+            if time_s - last.time_s < MIN_SAMPLE_INTERVAL_S {
+                return Err(Refusal::Duplicate);
             }
         }
         let repeated = self.last_received == Some((x, v));
@@ -776,6 +781,7 @@ mod tests {
         let (t, x, v) = s(1.0, 0.0);
         assert!(h.push(t, x, v).is_ok());
         assert_eq!(h.push(t, x, v), Err(Refusal::Duplicate));
+        assert_eq!(h.push(t + 0.5 * MIN_SAMPLE_INTERVAL_S, x, v), Err(Refusal::Duplicate));
         assert_eq!(h.push(0.5, x, v), Err(Refusal::Late));
         assert_eq!(h.push(2.0, [f64::NAN; 6], v), Err(Refusal::NonFinite));
         assert_eq!(h.len(), 1);
