@@ -147,9 +147,10 @@ struct RaoArgs {
     /// Radiation memory of the time-domain model.
     #[arg(long, value_enum, default_value = "convolution")]
     radiation: Radiation,
-    /// Time step of the time-domain model, s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.1)]
-    dt: f64,
+    /// Time step of the time-domain model, s. Default: the daemon's, 100 steps in the system's
+    /// shortest natural period (in whole 0.005 s, at most 0.1 s; `db check` prints it).
+    #[arg(long, allow_negative_numbers = true)]
+    dt: Option<f64>,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -400,6 +401,11 @@ fn db_check(path: &std::path::Path, all_pairs: bool) -> Result<()> {
             2.0 * std::f64::consts::PI / t
         )?;
     }
+    writeln!(
+        out,
+        "default solver step (the daemon's forecast.dt_s and rao --dt when not set): {}",
+        shipcast::rom::step::default_step(sys).describe(sys)
+    )?;
     writeln!(
         out,
         "impulse response: dt = {} s, memory {:.1} s, the database's damping; beyond w_N = {:.4} rad/s B_ij = B_N,ij (w_N/w)^((p_i + p_j)/2) + D_ij [(w_N/w)^{} - (w_N/w)^{}]",
@@ -935,6 +941,7 @@ fn rao(args: &RaoArgs) -> Result<()> {
     };
     let headings_rad: Vec<f64> = headings_deg.iter().map(|h| h.to_radians()).collect();
     let context = || args.system.display().to_string();
+    let dt_s = args.dt.unwrap_or_else(|| shipcast::rom::step::default_step(sys).dt_s);
     // [heading][omega][mode]
     let table: floor::RaoTable = match args.method {
         Method::Frequency => FrequencySolver::new(sys)
@@ -942,7 +949,7 @@ fn rao(args: &RaoArgs) -> Result<()> {
             .with_context(context)?,
         Method::Implied => {
             let opts = RomOptions {
-                dt_s: args.dt,
+                dt_s,
                 radiation: args.radiation.into(),
                 ..RomOptions::default()
             };
@@ -952,7 +959,7 @@ fn rao(args: &RaoArgs) -> Result<()> {
         Method::Time => {
             let t0 = std::time::Instant::now();
             let opts = RomOptions {
-                dt_s: args.dt,
+                dt_s,
                 radiation: args.radiation.into(),
                 speed_m_s: args.speed,
                 ..RomOptions::default()

@@ -508,9 +508,14 @@ fn a_python_console_decodes_a_live_forecast() {
     assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
     let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), 2);
+    // the config sets no step: the system's default (rom::step), 60 s of it
+    let sys = shipcast::files::load_system(&repo("config/vessels/ship/system.toml"))
+        .unwrap()
+        .system;
+    let dt_s = shipcast::rom::step::default_step(&sys).dt_s;
     for l in &lines {
-        assert_eq!(l["dt_s"], 0.1);
-        assert_eq!(l["steps"], 600);
+        assert_eq!(l["dt_s"], dt_s);
+        assert_eq!(l["steps"], (60.0 / dt_s).round() as u64);
         let h = l["vessels"][0]["heave_at_lead_s"]["30"].as_f64().unwrap();
         assert!(h.is_finite() && h.abs() < 10.0);
         assert!(l["vessels"][0]["horizon_s"].as_f64().unwrap() > 30.0);

@@ -5,6 +5,7 @@
 mod util;
 
 mod bad_input;
+mod capytaine_barge;
 mod capytaine_demo;
 mod cli;
 mod console;

@@ -140,7 +140,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         bail!("--duration {duration}: must be positive");
     }
     let t = Instant::now();
-    let mut sim = Simulation::new(&sys, service::rom_options(&cfg), sim_spec(&cfg, duration))
+    let mut sim = Simulation::new(&sys, service::rom_options(&cfg, &sys), sim_spec(&cfg, duration))
         .context("computing the true motion")?;
     tracing::info!(seconds = t.elapsed().as_secs_f64(), "true motion computed");
     let n_bodies = sim.n_bodies;

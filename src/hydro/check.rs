@@ -6,7 +6,6 @@ use super::radiation::{self, DampingTail, Irf, PairError};
 use super::system::{AInfSource, TailChoice};
 use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
-use std::f64::consts::PI;
 
 /// What `db check` reports.
 #[derive(Debug, Clone)]
@@ -187,30 +186,7 @@ pub fn system_irf(sys: &VesselSystem) -> Irf {
 pub fn check(sys: &VesselSystem) -> CheckReport {
     let db = &sys.db;
     let n = sys.n_modes();
-    let mass = sys.mass_matrix();
-    let c = sys.stiffness();
-    let mut natural = vec![];
-    for i in sys.active_indices() {
-        if c[(i, i)] <= 0.0 {
-            continue;
-        }
-        // lowest root of f(w) = C_ii - w^2 (M_ii + A_ii(w)) over the database frequencies (A can swing
-        // through gap resonances, so no fixed-point iteration); outside the range use A(w_min) / A_inf
-        let f = |w: f64, a: f64| c[(i, i)] - w * w * (mass[(i, i)] + a);
-        let ws = &db.omega_rad_s;
-        let fs: Vec<f64> = ws.iter().zip(&db.added_mass).map(|(w, a)| f(*w, a[(i, i)])).collect();
-        let w = if fs[0] <= 0.0 {
-            (c[(i, i)] / (mass[(i, i)] + db.added_mass_zero.as_ref().unwrap_or(&db.added_mass[0])[(i, i)])).sqrt()
-        } else if let Some(k) = fs.windows(2).position(|p| p[0] > 0.0 && p[1] <= 0.0) {
-            ws[k] + (ws[k + 1] - ws[k]) * fs[k] / (fs[k] - fs[k + 1])
-        } else {
-            let a = db.added_mass_inf.as_ref().unwrap_or(&db.added_mass[ws.len() - 1])[(i, i)];
-            (c[(i, i)] / (mass[(i, i)] + a)).sqrt()
-        };
-        if w.is_finite() && w > 0.0 {
-            natural.push((i, 2.0 * PI / w));
-        }
-    }
+    let natural = sys.natural_periods_s();
     let mut negative_damping = vec![];
     for i in 0..n {
         let ws: Vec<f64> = db

@@ -600,6 +600,37 @@ impl VesselSystem {
         out
     }
 
+    /// Undamped natural periods of the active DOFs with positive restoring, from the diagonal terms:
+    /// (global mode index, period s), each from the lowest frequency with C_ii = w^2 (M_ii + A_ii(w)).
+    pub fn natural_periods_s(&self) -> Vec<(usize, f64)> {
+        let db = &self.db;
+        let mass = self.mass_matrix();
+        let c = self.stiffness();
+        let mut natural = vec![];
+        for i in self.active_indices() {
+            if c[(i, i)] <= 0.0 {
+                continue;
+            }
+            // lowest root of f(w) = C_ii - w^2 (M_ii + A_ii(w)) over the database frequencies (A can swing
+            // through gap resonances, so no fixed-point iteration); outside the range use A(w_min) / A_inf
+            let f = |w: f64, a: f64| c[(i, i)] - w * w * (mass[(i, i)] + a);
+            let ws = &db.omega_rad_s;
+            let fs: Vec<f64> = ws.iter().zip(&db.added_mass).map(|(w, a)| f(*w, a[(i, i)])).collect();
+            let w = if fs[0] <= 0.0 {
+                (c[(i, i)] / (mass[(i, i)] + db.added_mass_zero.as_ref().unwrap_or(&db.added_mass[0])[(i, i)])).sqrt()
+            } else if let Some(k) = fs.windows(2).position(|p| p[0] > 0.0 && p[1] <= 0.0) {
+                ws[k] + (ws[k + 1] - ws[k]) * fs[k] / (fs[k] - fs[k + 1])
+            } else {
+                let a = db.added_mass_inf.as_ref().unwrap_or(&db.added_mass[ws.len() - 1])[(i, i)];
+                (c[(i, i)] / (mass[(i, i)] + a)).sqrt()
+            };
+            if w.is_finite() && w > 0.0 {
+                natural.push((i, 2.0 * std::f64::consts::PI / w));
+            }
+        }
+        natural
+    }
+
     /// Indices (0-based, global) of the active DOFs.
     pub fn active_indices(&self) -> Vec<usize> {
         self.spec

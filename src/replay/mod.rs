@@ -642,7 +642,7 @@ pub fn drive(
     use crate::ipc::{Input, Output};
     use crate::service::{Computer, Engine, rom_options};
     crate::service::fits_the_wire(sys)?;
-    let model = crate::rom::TimeModel::new(sys, rom_options(cfg))?;
+    let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
     let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg.forecast.horizon_s);
     let period = cfg.forecast.period_s;

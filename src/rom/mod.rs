@@ -38,6 +38,7 @@ pub mod outputs;
 pub mod partitioned;
 pub mod regular;
 pub mod sinusoids;
+pub mod step;
 pub mod stepper;
 
 pub use forecast::{Forecast, ForecastRequest, Forecaster};

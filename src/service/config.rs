@@ -84,8 +84,8 @@ pub struct ForecastConfig {
     pub period_s: f64,
     /// Length of each forecast, s.
     pub horizon_s: f64,
-    /// Solver step, s.
-    pub dt_s: f64,
+    /// Solver step, s (None: chosen from the system's shortest natural period, `rom::step`).
+    pub dt_s: Option<f64>,
     /// "convolution" or "state-space".
     pub radiation: String,
     /// Radiation memory, s (default: the database's).
@@ -125,7 +125,7 @@ impl Default for ForecastConfig {
         ForecastConfig {
             period_s: 1.0,
             horizon_s: 120.0,
-            dt_s: 0.1,
+            dt_s: None,
             radiation: "convolution".into(),
             memory_s: None,
             max_wave_age_s: 10.0,
@@ -851,17 +851,19 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         }
     }
     let f = &c.forecast;
-    crate::service::rom_options(c)
+    // the default step is the system's (known once it is loaded): the longest it can be stands in
+    crate::service::options_at(c, f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S))
         .validate()
         .map_err(|e| (format!("forecast.{}", e.field), e.msg))?;
-    let steps = f.horizon_s / f.dt_s;
+    let dt_s = f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S);
+    let steps = f.horizon_s / dt_s;
     if steps > crate::rom::forecast::MAX_FORECAST_STEPS as f64 {
         return Err((
             "forecast.horizon_s".into(),
             format!(
                 "{} s at forecast.dt_s = {} s is {steps:.0} steps, more than {}",
                 f.horizon_s,
-                f.dt_s,
+                dt_s,
                 crate::rom::forecast::MAX_FORECAST_STEPS
             ),
         ));

@@ -38,10 +38,29 @@ pub fn wall_s() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// The model options a configuration asks for.
-pub fn rom_options(cfg: &ShipcastConfig) -> RomOptions {
+/// The model options a configuration asks for, for this system: the step is `forecast.dt_s`, or when
+/// that is not set the one chosen from the system's natural periods ([`crate::rom::step`]).
+pub fn rom_options(cfg: &ShipcastConfig, sys: &VesselSystem) -> RomOptions {
+    options_at(
+        cfg,
+        cfg.forecast
+            .dt_s
+            .unwrap_or_else(|| crate::rom::step::default_step(sys).dt_s),
+    )
+}
+
+/// The solver step in words: the configured one, or the one chosen and why.
+pub fn describe_step(cfg: &ShipcastConfig, sys: &VesselSystem) -> String {
+    match cfg.forecast.dt_s {
+        Some(dt) => format!("{dt} s (forecast.dt_s)"),
+        None => crate::rom::step::default_step(sys).describe(sys),
+    }
+}
+
+/// The model options of a configuration at step `dt_s`.
+pub fn options_at(cfg: &ShipcastConfig, dt_s: f64) -> RomOptions {
     RomOptions {
-        dt_s: cfg.forecast.dt_s,
+        dt_s,
         radiation: if cfg.forecast.radiation == "state-space" {
             RadiationMethod::StateSpace
         } else {
@@ -358,6 +377,8 @@ fn power_of_ten(mut n: u64) -> bool {
 /// time live, the log's time in replay): the same code for both.
 pub struct Engine {
     cfg: config::ForecastConfig,
+    /// The model's step, s.
+    dt_s: f64,
     origin_m: [f64; 2],
     n_bodies: usize,
     taps: usize,
@@ -392,13 +413,14 @@ impl Engine {
         let taps = match &model.kernel {
             crate::rom::model::Kernel::Convolution { taps, .. } => *taps,
             crate::rom::model::Kernel::StateSpace { .. } => {
-                (cfg.forecast.memory_s.unwrap_or(STATE_SPACE_HISTORY_S) / cfg.forecast.dt_s).round() as usize
+                (cfg.forecast.memory_s.unwrap_or(STATE_SPACE_HISTORY_S) / model.opts.dt_s).round() as usize
             }
         };
-        let keep_s = taps as f64 * cfg.forecast.dt_s + cfg.forecast.history_margin_s;
+        let keep_s = taps as f64 * model.opts.dt_s + cfg.forecast.history_margin_s;
         let (positions, heading) = vessel_positions(cfg, sys);
         Engine {
             cfg: cfg.forecast.clone(),
+            dt_s: model.opts.dt_s,
             origin_m: [cfg.site.origin_east_m, cfg.site.origin_north_m],
             n_bodies,
             taps,
@@ -440,7 +462,7 @@ impl Engine {
 
     /// Radiation memory the engine keeps, s.
     pub fn memory_s(&self) -> f64 {
-        self.taps as f64 * self.cfg.dt_s
+        self.taps as f64 * self.dt_s
     }
 
     /// One input that arrived at `clock_s` (engine clock). Every stamp is judged against its source's
@@ -601,7 +623,7 @@ impl Engine {
         if can && self.busy {
             self.counters.overruns += 1;
         } else if can && let Some(f) = &self.field {
-            let dt = cfg.dt_s;
+            let dt = self.dt_s;
             let n_hist = self.taps.saturating_sub(1);
             let mut x0 = vec![0.0; self.n_active];
             let mut v0 = vec![0.0; self.n_active];
@@ -784,12 +806,13 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     fits_the_wire(&sys)?;
     let n_bodies = sys.spec.bodies.len();
     let t_build = Instant::now();
-    let model = TimeModel::new(&sys, rom_options(&cfg))?;
+    let model = TimeModel::new(&sys, rom_options(&cfg, &sys))?;
     let mut engine = Engine::new(&cfg, &sys, &model);
     tracing::info!(
         vessels = n_bodies,
         active_dofs = model.n(),
         memory_s = engine.memory_s(),
+        step = %describe_step(&cfg, &sys),
         build_s = t_build.elapsed().as_secs_f64(),
         "model ready"
     );
