@@ -9,6 +9,7 @@
 use crate::files::Loaded;
 use crate::hydro::check::{self, CheckReport, mode_label};
 use crate::hydro::external::ConnectionKind;
+use crate::hydro::memory;
 use crate::hydro::modal::ModalModel;
 use crate::hydro::radiation::{self, PairError};
 use crate::hydro::system::{AInfSource, TailChoice};
@@ -174,8 +175,8 @@ impl<'a> DbCheck<'a> {
 
 /// The state-space line's numbers of the model `m` with radiation `ss`, its fit timed from `t_fit`.
 fn state_space_fit(sys: &VesselSystem, m: &TimeModel, ss: &ModalModel, t_fit: std::time::Instant) -> StateSpaceFit {
-    let mem = check::state_space_memory(sys, check::memory_duration_s(sys));
-    let (eb, ea) = check::state_space_errors(sys, ss, &check::model_a_inf(sys, &mem.irf), &mem.tail);
+    let mem = memory::state_space_memory(sys, memory::memory_duration_s(sys));
+    let (eb, ea) = check::state_space_errors(sys, ss, &memory::model_a_inf(sys, &mem.irf), &mem.tail);
     let n_hsv = ss.hankel.len().min(ss.real_order() + 1);
     StateSpaceFit {
         fit_pairs: ss.fit_pairs,

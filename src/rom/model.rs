@@ -3,7 +3,7 @@
 use super::modal::ModalStep;
 use super::partitioned::{Partitions, block_for};
 use super::{Error, Result};
-use crate::hydro::check::{
+use crate::hydro::memory::{
     RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
 };
 use crate::hydro::modal::{ModalModel, ModalOptions};
