@@ -4,8 +4,8 @@
 //! time-domain models build it.
 
 use super::memory::{RadiationMemory, active_radiation, system_memory};
-use super::modal;
 use super::radiation::{self, DampingTail, Irf, PairError};
+use super::statespace;
 use super::system::AInfSource;
 use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
@@ -73,15 +73,15 @@ pub fn choose_a_inf(sys: &VesselSystem, irf: &Irf) -> (DMatrix<f64>, AInfSource)
 }
 
 /// The (damping, added mass) errors of a state-space model of the active DOFs' radiation (see
-/// [`modal::fit_errors`]), the added mass against the given A_inf.
+/// [`statespace::fit_errors`]), the added mass against the given A_inf.
 pub fn state_space_errors(
     sys: &VesselSystem,
-    model: &modal::ModalModel,
+    model: &statespace::ModalModel,
     a_inf: &DMatrix<f64>,
     tail: &DampingTail,
 ) -> (f64, f64) {
     let r = active_radiation(sys, a_inf, tail);
-    modal::fit_errors(model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf)
+    statespace::fit_errors(model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf)
 }
 
 pub fn check(sys: &VesselSystem) -> CheckReport {

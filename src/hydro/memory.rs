@@ -6,8 +6,8 @@
 //! report describes the model that runs.
 
 use super::VesselSystem;
-use super::modal;
 use super::radiation::{self, DampingTail, Irf};
+use super::statespace;
 use super::system::{AInfSource, TailChoice};
 use nalgebra::DMatrix;
 
@@ -62,9 +62,13 @@ pub struct ActiveRadiation {
 }
 
 impl ActiveRadiation {
-    /// The state-space fit of this radiation ([`modal::fit`]) at the database's frequencies `omegas`.
-    pub fn fit(&self, omegas: &[f64], opts: modal::ModalOptions) -> Result<modal::ModalModel, modal::FitError> {
-        modal::fit(omegas, &self.damping, &self.added_mass, &self.a_inf, &self.tail, opts)
+    /// The state-space fit of this radiation ([`statespace::fit`]) at the database's frequencies `omegas`.
+    pub fn fit(
+        &self,
+        omegas: &[f64],
+        opts: statespace::ModalOptions,
+    ) -> Result<statespace::ModalModel, statespace::FitError> {
+        statespace::fit(omegas, &self.damping, &self.added_mass, &self.a_inf, &self.tail, opts)
     }
 }
 

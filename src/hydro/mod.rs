@@ -3,7 +3,7 @@
 //! Owns: the WAMIT readers ([`wamit`]), the system file ([`system`]), the assembled database with its
 //! interpolation over frequency and heading ([`db`]), and radiation: impulse response functions,
 //! A_inf and the Kramers-Kronig check ([`radiation`]), the radiation memory the time-domain models are
-//! built from ([`memory`]), the state-space fit ([`modal`]) and `db check`'s checks ([`check`]).
+//! built from ([`memory`]), the state-space fit ([`statespace`]) and `db check`'s checks ([`check`]).
 //!
 //! Conventions (DESIGN.md section 1, contracts):
 //! - SI units: m, s, kg, N, rad. Degrees only where a name says `_deg`.
@@ -19,8 +19,8 @@ pub mod check;
 pub mod db;
 pub mod external;
 pub mod memory;
-pub mod modal;
 pub mod radiation;
+pub mod statespace;
 pub mod system;
 pub mod wamit;
 

@@ -6,8 +6,8 @@ use super::{Error, Result};
 use crate::hydro::memory::{
     RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
 };
-use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation;
+use crate::hydro::statespace::{ModalModel, ModalOptions};
 use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
 
@@ -199,8 +199,7 @@ impl TimeModel {
         // the IRF from passive damping and the damping tail, fitted where it is sampled: the convolution
         // samples K at the solver's step; the state-space model is fitted once per database (and speed)
         // on the system file's IRF grid (`irf.dt_s`), so it, its tail and its A_inf do not move with the
-        // solver's step (measured on the pair: refitted at each step, its floor was 1.9 % of peak off
-        // the frequency domain at dt = 0.05 s and 3.3 % at 0.025 s, lighter yaw in beam seas at 0.05 rad/s)
+        // solver's step (a fit at each step would move the model's floor with dt)
         let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
         // the grids K is sampled on: the solver's (convolution) and the system file's (state-space fit)
         let grid_dt = match opts.radiation {
@@ -215,9 +214,8 @@ impl TimeModel {
             RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
             _ => radiation_memory(sys, dt, memory_s),
         };
-        // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
-        // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
-        // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
+        // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's
+        // (Ogilvie's is consistent with the K the model runs, so its floor is the closer one)
         let a_inf_all = model_a_inf(sys, &irf_all);
         let terms = sys.linear_terms();
         let pad = |m: &DMatrix<f64>| sys.pad_states(m);
@@ -275,9 +273,8 @@ impl TimeModel {
                     damping[(i, i)] += model.cover * model.scale[i];
                 }
                 // A_inf as the convolution's (Ogilvie's from the IRF unless the system file asks for the
-                // database's): the fit reproduces the same damping and tail, so the same K. Measured: the
-                // Ogilvie estimate from the fitted kernel instead put the pair's lighter yaw 3.6 % of
-                // peak off the frequency domain at heading 150 (1.8 % this way), the ship 0.38 % (0.33 %)
+                // database's): the fit reproduces the same damping and tail, so the same K; an Ogilvie
+                // estimate from the fitted kernel would carry the fit's error into the added mass
                 (
                     Kernel::StateSpace {
                         model: Box::new(model),

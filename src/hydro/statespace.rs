@@ -324,9 +324,8 @@ pub fn fit(
 /// (CHECK_POINTS + 1 points), plus points within 8 half-widths of every pole narrower than 4 grid spacings.
 pub fn check_grid(poles: &[Complex64], omega_max: f64) -> Vec<f64> {
     let dw = CHECK_SPAN * omega_max / CHECK_POINTS as f64;
-    // w = 0 included: a negative Re K(0) is a drag that pushes a free drift (measured on WEC-Sim's RM3
-    // once slow modes were held in the enforcement: -9e-5 of the peak damping on every heave, unseen
-    // while the grid began at dw)
+    // w = 0 included: a negative Re K(0) is a drag that pushes a free drift, and a grid beginning at dw
+    // does not see it
     let mut grid: Vec<f64> = (0..=CHECK_POINTS).map(|k| k as f64 * dw).collect();
     for p in poles {
         let hw = p.re.abs().max(1e-9);
@@ -423,16 +422,8 @@ fn violations(
 /// 1 + (w_low / |lambda|)^2 with w_low = `low_band_rad_s`: a residue change dr at pole lambda moves the
 /// added mass at low frequency by about dr / |lambda|^2 (r / (iw - lambda) to first order in w), and the
 /// response of a DOF without restoring is its mass there, so slow modes pay for that leverage.
-/// Measured on the pair demo (worst |difference| / curve peak of the state-space floor against the
-/// convolution's, lighter yaw in beam seas at 0.05 rad/s): 2.16 % with the share alone; w_low = 0.1 /
-/// 0.3 / 1 / 3 rad/s: 1.40 / 1.18 / 1.22 / 1.28 % (the fit uses 0.28 rad/s there; 1.25 % once w = 0 joined
-/// the check grid).
-/// Tried and dropped (session 14, pair demo): holding Re K(0) = 0 (every entry, scaled) as equality rows
-/// beside the violations, w = 0 taken off the margin (and, a second try, the margin scaled by (w / w_1)^2
-/// below the lowest database frequency w_1): 30 passes did not converge (violations kept returning
-/// between 0.03 and 0.4 rad/s, K(0) between 1e-7 and 6e-5 of scale pass to pass) and the floor against
-/// the convolution's went from 1.25 % to 10-12 % (lighter yaw, beam seas, 0.15 rad/s). K(0) = 0 with
-/// Re K >= 0 beside it asks a PSD curvature at w = 0 the low band's tiny damping does not have.
+/// Re K(0) is not held at zero: K(0) = 0 with Re K >= 0 beside it asks a PSD curvature at w = 0 that the
+/// low band's tiny damping does not have, and the enforcement does not converge with it.
 fn enforce_passivity(
     poles: &[Complex64],
     mut b: DMatrix<Complex64>,
@@ -808,10 +799,9 @@ impl Realization {
     }
 
     /// Square-root balanced truncation: (A_r, B_r, C_r) and the Hankel singular values.
-    /// Measured and not used (session 14, pair demo, 480 states to 219): singular perturbation instead of
-    /// truncation keeps the fit's K(0) = 0, but moves the same error to infinite frequency as a
-    /// feedthrough D_r = -C_2 A_22^-1 B_2 of both signs (largest 1.1e-4 scaled, eigenvalues -1.7e-4 to
-    /// 1.9e-4; truncation's K(0): largest 1.4e-4, -1.8e-4 to 2.8e-4): a damping that no residue reaches.
+    /// Truncation, not singular perturbation: the latter keeps the fit's K(0) = 0 but moves the same
+    /// error to infinite frequency as a feedthrough D_r = -C_2 A_22^-1 B_2 of both signs, a damping that
+    /// no residue reaches.
     fn balanced_truncation(&self, tol: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, Vec<f64>) {
         let n = self.n;
         let nb = self.s.len();
