@@ -34,7 +34,7 @@ enum Command {
     },
     /// Motion RAOs of a system as CSV on stdout: omega,heading_deg,mode,amplitude,phase_deg.
     Rao(cli::rao::RaoArgs),
-    /// Forecast a scenario (system, sea, speed, history, horizon); with --repeat, time it.
+    /// Forecast a scenario (system, sea, speed, history, length); with --repeat, time it.
     Forecast(cli::forecast::ForecastArgs),
     /// The predictable horizon of a radar disc in a sea state; last line `horizon_s=<x>`.
     Horizon(cli::horizon::HorizonArgs),

@@ -1,7 +1,8 @@
-//! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and horizon. The
+//! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and length. The
 //! measured past is simulated: a model runs from rest in the same sea for `history_s` (a spin-up whose
 //! velocities become the memory and whose end state is the state at t0), then the forecasting model
-//! forecasts `horizon_s`. The past is simulated by the reference (direct convolution) whatever method
+//! forecasts for the scenario's length (key `horizon_s`, or `length_s`: the forecast's length, not a
+//! predictable horizon). The past is simulated by the reference (direct convolution) whatever method
 //! forecasts, as a measured past would not depend on it: the methods then differ only by their forecasts.
 
 use crate::files;
@@ -16,7 +17,9 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
     system: String,
-    horizon_s: f64,
+    /// The forecast's length, s (key `horizon_s`, or `length_s`).
+    #[serde(rename = "horizon_s", alias = "length_s")]
+    length_s: f64,
     history_s: f64,
     #[serde(default = "default_dt")]
     dt_s: f64,
@@ -101,7 +104,8 @@ pub enum Waves {
 #[derive(Debug, Clone)]
 pub struct Scenario {
     pub system: PathBuf,
-    pub horizon_s: f64,
+    /// The forecast's length, s (the file's `horizon_s`).
+    pub length_s: f64,
     pub history_s: f64,
     pub opts: RomOptions,
     pub waves: Waves,
@@ -122,7 +126,7 @@ impl Scenario {
             msg: format!("{k}: {m}"),
         };
         for (k, v) in [
-            ("horizon_s", raw.horizon_s),
+            ("horizon_s", raw.length_s),
             ("history_s", raw.history_s),
             ("dt_s", raw.dt_s),
         ] {
@@ -130,13 +134,13 @@ impl Scenario {
                 return Err(bad(k, format!("must be positive, found {v}")));
             }
         }
-        if raw.horizon_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
+        if raw.length_s > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
             return Err(bad(
                 "horizon_s",
                 format!(
                     "at most {} s, found {}",
                     crate::rom::forecast::MAX_FORECAST_LENGTH_S,
-                    raw.horizon_s
+                    raw.length_s
                 ),
             ));
         }
@@ -228,7 +232,7 @@ impl Scenario {
         opts.validate().map_err(|e| bad(e.field, e.msg))?;
         Ok(Scenario {
             system: path.parent().unwrap_or(Path::new(".")).join(raw.system),
-            horizon_s: raw.horizon_s,
+            length_s: raw.length_s,
             history_s: raw.history_s,
             opts,
             waves,
@@ -247,14 +251,14 @@ pub struct Prepared {
 }
 
 impl Prepared {
-    /// The forecast request from this state, over `horizon_s`.
-    pub fn request(&self, horizon_s: f64) -> ForecastRequest<'_> {
+    /// The forecast request from this state, `length_s` long.
+    pub fn request(&self, length_s: f64) -> ForecastRequest<'_> {
         ForecastRequest {
             x0: &self.x0,
             v0: &self.v0,
             memory: &self.memory,
             waves: &self.waves,
-            horizon_s,
+            horizon_s: length_s,
             ramp_s: 0.0,
         }
     }

@@ -15,8 +15,8 @@ pub struct ForecastArgs {
     /// The scenario file (e.g. config/scenarios/two-ship.toml).
     pub scenario: PathBuf,
     /// Forecast length, s, in (0, 3600] (default: the scenario's).
-    #[arg(long, allow_negative_numbers = true, value_parser = forecast_length)]
-    pub horizon: Option<f64>,
+    #[arg(long = "horizon", visible_alias = "length", value_name = "SECONDS", allow_negative_numbers = true, value_parser = forecast_length)]
+    pub length_s: Option<f64>,
     /// Run the forecast N times and print the median and p95 wall time of one, as the last line.
     #[arg(long, allow_negative_numbers = true, default_value_t = 1)]
     pub repeat: usize,
@@ -31,7 +31,7 @@ pub struct ForecastArgs {
     pub out: Option<PathBuf>,
 }
 
-/// `--horizon`: checked as it is read, before any work.
+/// `--horizon` (the forecast's length): checked as it is read, before any work.
 pub fn forecast_length(s: &str) -> Result<f64, String> {
     let max = shipcast::rom::forecast::MAX_FORECAST_LENGTH_S;
     match s.trim().parse::<f64>() {
@@ -49,8 +49,8 @@ pub enum Format {
 
 pub fn run(args: &ForecastArgs) -> Result<()> {
     let mut sc = Scenario::load(&args.scenario)?;
-    if let Some(h) = args.horizon {
-        sc.horizon_s = h;
+    if let Some(l) = args.length_s {
+        sc.length_s = l;
     }
     if let Some(r) = args.radiation {
         sc.opts.radiation = r.into();
@@ -73,7 +73,7 @@ pub fn run(args: &ForecastArgs) -> Result<()> {
     let prep =
         prepare(past.as_ref().unwrap_or(&model), &model, &sc.waves, sc.history_s).context("spin-up of the history")?;
     let mut fc = Forecaster::new();
-    let req = prep.request(sc.horizon_s);
+    let req = prep.request(sc.length_s);
     let mut times_ms = vec![];
     for _ in 0..args.repeat {
         let t = std::time::Instant::now();
@@ -137,13 +137,13 @@ pub fn run(args: &ForecastArgs) -> Result<()> {
         None => out.write_all(text.as_bytes())?,
     }
     eprintln!(
-        "shipcast forecast: {} ({} active DOFs, {} wave components, {:?} radiation, memory {}), horizon {} s at dt {} s; model built in {:.2} s",
+        "shipcast forecast: {} ({} active DOFs, {} wave components, {:?} radiation, memory {}), length {} s at dt {} s; model built in {:.2} s",
         args.scenario.display(),
         model.n(),
         prep.waves.len(),
         sc.opts.radiation,
         model.memory_size(),
-        sc.horizon_s,
+        sc.length_s,
         sc.opts.dt_s,
         build_s
     );

@@ -452,7 +452,7 @@ fn report(
     sys: &shipcast::hydro::VesselSystem,
     records: &[(f64, Record)],
     forecasts: &[ForecastRecord],
-    horizon_s: f64,
+    length_s: f64,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let nb = sys.spec.bodies.len();
@@ -479,7 +479,7 @@ fn report(
                     }
                 })
                 .collect();
-            let sk = skill::score(&fs, measured, step, horizon_s);
+            let sk = skill::score(&fs, measured, step, length_s);
             lead = sk.lead_s.clone();
             let arr = |v: &[f64]| {
                 v.iter()
