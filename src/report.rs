@@ -7,13 +7,13 @@
 //! state-space fit, for the report.
 
 use crate::files::Loaded;
-use crate::hydro::check::{self, CheckReport, mode_label};
+use crate::hydro::check::{self, CheckReport};
 use crate::hydro::external::ConnectionKind;
 use crate::hydro::memory;
 use crate::hydro::radiation::{self, PairError};
 use crate::hydro::statespace::ModalModel;
 use crate::hydro::system::{AInfSource, TailChoice};
-use crate::hydro::{Dof, VesselSystem};
+use crate::hydro::{Dof, VesselSystem, mode_label};
 use crate::rao::FrequencySolver;
 use crate::rom::model::Kernel;
 use crate::rom::{RadiationMethod, RomOptions, TimeModel, floor};

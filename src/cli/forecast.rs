@@ -4,7 +4,6 @@ use super::Radiation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use shipcast::files;
-use shipcast::hydro::check;
 use shipcast::rom::{Forecaster, TimeModel};
 use shipcast::scenario::{Scenario, past_options, prepare};
 use std::io::Write;
@@ -81,8 +80,10 @@ pub fn run(args: &ForecastArgs) -> Result<()> {
         times_ms.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let f = fc.forecast(&model, &req)?;
-    let labels: Vec<String> = (0..sys.n_states()).map(|i| check::output_label(sys, i)).collect();
-    let value = |k: usize, i: usize| check::output_value(sys, i, f.at(k, i));
+    let labels: Vec<String> = (0..sys.n_states())
+        .map(|i| shipcast::hydro::output_label(sys, i))
+        .collect();
+    let value = |k: usize, i: usize| shipcast::hydro::output_value(sys, i, f.at(k, i));
     let extra = shipcast::rom::outputs::derived(&sys.spec.external, f);
     let horizons = scenario_horizons(sys, &sc, &prep.waves);
     let mut text = String::new();

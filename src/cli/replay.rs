@@ -48,8 +48,6 @@ pub struct ReplayArgs {
     at: Vec<f64>,
 }
 
-const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
-
 /// MCAP's magic number, the first and last 8 bytes of every MCAP file.
 const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
 
@@ -465,7 +463,7 @@ fn report(
     for b in 0..nb {
         let name = &sys.spec.bodies[b].name;
         let mut dofs = vec![];
-        for (d, dof) in DOFS.iter().enumerate() {
+        for (d, dof) in shipcast::hydro::Dof::NAMES.iter().enumerate() {
             let measured = &measured_all[6 * b + d];
             let fs: Vec<SeriesForecast> = forecasts
                 .iter()

@@ -3,11 +3,11 @@
 //! the state-space fit's errors. The radiation memory they check is built in [`super::memory`], as the
 //! time-domain models build it.
 
+use super::VesselSystem;
 use super::memory::{RadiationMemory, active_radiation, system_memory};
 use super::radiation::{self, DampingTail, Irf, PairError};
 use super::statespace;
 use super::system::AInfSource;
-use super::{Dof, VesselSystem};
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 
@@ -151,36 +151,6 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
         asymmetry_added_mass: asymmetry(&db.added_mass),
         asymmetry_damping: asymmetry(&db.damping),
         passivity_repair: radiation::passive_damping(&db.damping).1,
-    }
-}
-
-/// `carrier.heave` style label of a 0-based global mode index.
-pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
-    if i >= sys.n_modes() {
-        let k = i - sys.n_modes();
-        let name = sys.spec.external.tank_names.get(k).map(|s| s.as_str()).unwrap_or("?");
-        return format!("{name}.tank_angle");
-    }
-    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
-    format!("{body}.{}", Dof::of_index(i).name())
-}
-
-/// The output column of state `i` with its unit (`carrier.heave_m`, `carrier.roll_deg`,
-/// `<tank>.tank_angle_deg`), as CSV and JSON outputs write it; [`output_value`] converts the value.
-pub fn output_label(sys: &VesselSystem, i: usize) -> String {
-    if i >= sys.n_modes() {
-        return format!("{}_deg", mode_label(sys, i));
-    }
-    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
-    format!("{body}.{}", Dof::of_index(i).output_name())
-}
-
-/// State `i`'s value (m or rad) in the unit of its [`output_label`] (m or deg; a tank angle in deg).
-pub fn output_value(sys: &VesselSystem, i: usize, si: f64) -> f64 {
-    if i >= sys.n_modes() {
-        si.to_degrees()
-    } else {
-        Dof::of_index(i).to_output(si)
     }
 }
 

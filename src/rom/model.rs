@@ -317,10 +317,7 @@ impl TimeModel {
             let z = vec![0.0; sys.n_states()];
             e.nonlinear_force(&z, &z, &mut nl_offset);
         }
-        let labels = active
-            .iter()
-            .map(|&i| crate::hydro::check::mode_label(sys, i))
-            .collect();
+        let labels = active.iter().map(|&i| crate::hydro::mode_label(sys, i)).collect();
         let mut bdc = DMatrix::zeros(n, 2 * n);
         bdc.view_mut((0, 0), (n, n)).copy_from(&(&damping + &d_inst));
         bdc.view_mut((0, n), (n, n)).copy_from(&stiffness);
