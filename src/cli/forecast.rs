@@ -3,8 +3,11 @@
 use super::Radiation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use serde::Serialize;
 use shipcast::files;
-use shipcast::rom::{Forecaster, TimeModel};
+use shipcast::hydro::VesselSystem;
+use shipcast::rom::outputs::Derived;
+use shipcast::rom::{Forecast, Forecaster, RadiationMethod, TimeModel};
 use shipcast::scenario::{Scenario, past_options, prepare};
 use std::io::Write;
 use std::path::PathBuf;
@@ -80,58 +83,12 @@ pub fn run(args: &ForecastArgs) -> Result<()> {
         times_ms.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let f = fc.forecast(&model, &req)?;
-    let labels: Vec<String> = (0..sys.n_states())
-        .map(|i| shipcast::hydro::output_label(sys, i))
-        .collect();
-    let value = |k: usize, i: usize| shipcast::hydro::output_value(sys, i, f.at(k, i));
     let extra = shipcast::rom::outputs::derived(&sys.spec.external, f);
     let horizons = scenario_horizons(sys, &sc, &prep.waves);
-    let mut text = String::new();
-    match args.format {
-        Format::Csv => {
-            text.push_str("t_s");
-            for l in labels.iter().chain(&extra.names) {
-                text.push(',');
-                text.push_str(l);
-            }
-            text.push('\n');
-            for k in 0..=f.steps {
-                text.push_str(&format!("{:.3}", k as f64 * f.dt_s));
-                for i in 0..f.n_modes {
-                    text.push_str(&format!(",{:.6e}", value(k, i)));
-                }
-                for c in 0..extra.names.len() {
-                    text.push_str(&format!(",{:.6e}", extra.at(k, c)));
-                }
-                text.push('\n');
-            }
-        }
-        Format::Json => {
-            let series = |n: usize, name: &dyn Fn(usize) -> String, at: &dyn Fn(usize, usize) -> f64| -> String {
-                (0..n)
-                    .map(|i| {
-                        let v: Vec<String> = (0..=f.steps).map(|k| format!("{:.6e}", at(k, i))).collect();
-                        format!("\"{}\":[{}]", name(i), v.join(","))
-                    })
-                    .collect::<Vec<_>>()
-                    .join(",")
-            };
-            let motion = series(f.n_modes, &|i| labels[i].clone(), &value);
-            let derived = series(extra.names.len(), &|c| extra.names[c].clone(), &|k, c| extra.at(k, c));
-            text.push_str(&format!(
-                "{{\"dt_s\":{},\"horizon_s\":{},\"predictable_horizon_s\":{{{}}},\"radiation\":\"{:?}\",\"skipped_components\":{},\"motion\":{{{motion}}},\"points\":{{{derived}}}}}\n",
-                f.dt_s,
-                f.steps as f64 * f.dt_s,
-                horizons
-                    .iter()
-                    .map(|(n, h)| format!("\"{n}\":{}", if h.is_finite() { format!("{h:.1}") } else { "null".into() }))
-                    .collect::<Vec<_>>()
-                    .join(","),
-                sc.opts.radiation,
-                f.skipped_components,
-            ));
-        }
-    }
+    let text = match args.format {
+        Format::Csv => csv_text(sys, f, &extra),
+        Format::Json => json_text(sys, f, &extra, &horizons, sc.opts.radiation)?,
+    };
     let mut out = std::io::stdout().lock();
     match &args.out {
         Some(p) => std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?,
@@ -169,6 +126,82 @@ pub fn run(args: &ForecastArgs) -> Result<()> {
     Ok(())
 }
 
+/// The forecast as CSV: `t_s`, then every state's column (units in the names), then the points',
+/// relative motions' and connections' columns, 7 significant digits.
+fn csv_text(sys: &VesselSystem, f: &Forecast, extra: &Derived) -> String {
+    let labels: Vec<String> = (0..sys.n_states())
+        .map(|i| shipcast::hydro::output_label(sys, i))
+        .collect();
+    let value = |k: usize, i: usize| shipcast::hydro::output_value(sys, i, f.at(k, i));
+    let mut text = String::new();
+    text.push_str("t_s");
+    for l in labels.iter().chain(&extra.names) {
+        text.push(',');
+        text.push_str(l);
+    }
+    text.push('\n');
+    for k in 0..=f.steps {
+        text.push_str(&format!("{:.3}", k as f64 * f.dt_s));
+        for i in 0..f.n_modes {
+            text.push_str(&format!(",{:.6e}", value(k, i)));
+        }
+        for c in 0..extra.names.len() {
+            text.push_str(&format!(",{:.6e}", extra.at(k, c)));
+        }
+        text.push('\n');
+    }
+    text
+}
+
+/// The forecast as one JSON object ([`ForecastJson`]).
+fn json_text(
+    sys: &VesselSystem,
+    f: &Forecast,
+    extra: &Derived,
+    horizons: &[(String, f64)],
+    radiation: RadiationMethod,
+) -> Result<String> {
+    let labels: Vec<String> = (0..sys.n_states())
+        .map(|i| shipcast::hydro::output_label(sys, i))
+        .collect();
+    let value = |k: usize, i: usize| shipcast::hydro::output_value(sys, i, f.at(k, i));
+    let motion: Vec<(String, Vec<Option<f64>>)> = (0..f.n_modes)
+        .map(|i| {
+            (
+                labels[i].clone(),
+                (0..=f.steps).map(|k| seven_digits(value(k, i))).collect(),
+            )
+        })
+        .collect();
+    let points: Vec<(String, Vec<Option<f64>>)> = (0..extra.names.len())
+        .map(|c| {
+            let v = (0..=f.steps).map(|k| seven_digits(extra.at(k, c))).collect();
+            (extra.names[c].clone(), v)
+        })
+        .collect();
+    let predictable: Vec<(String, Option<f64>)> = horizons
+        .iter()
+        .map(|(n, h)| {
+            (
+                n.clone(),
+                format!("{h:.1}").parse().ok().filter(|h: &f64| h.is_finite()),
+            )
+        })
+        .collect();
+    let doc = ForecastJson {
+        dt_s: f.dt_s,
+        horizon_s: f.steps as f64 * f.dt_s,
+        predictable_horizon_s: InOrder(&predictable),
+        radiation: format!("{:?}", radiation),
+        skipped_components: f.skipped_components,
+        motion: InOrder(&motion),
+        points: InOrder(&points),
+    };
+    let mut text = serde_json::to_string(&doc)?;
+    text.push('\n');
+    Ok(text)
+}
+
 /// The predictable horizon of each vessel in a scenario: the sea at t0 seen over the scenario's radar
 /// disc around the origin (infinite without one), each vessel at its reference point.
 pub fn scenario_horizons(
@@ -198,4 +231,55 @@ pub fn scenario_horizons(
             (b.name.clone(), h.horizon_s)
         })
         .collect()
+}
+
+/// `--format json`: one object; series in the CSV's order and precision (7 significant digits), a
+/// non-finite number written as null.
+#[derive(Serialize)]
+struct ForecastJson<'a> {
+    dt_s: f64,
+    /// The forecast's length, s (the name users read).
+    horizon_s: f64,
+    /// Each vessel's predictable horizon, s (null: unlimited).
+    predictable_horizon_s: InOrder<'a, Option<f64>>,
+    radiation: String,
+    skipped_components: usize,
+    motion: InOrder<'a, Vec<Option<f64>>>,
+    points: InOrder<'a, Vec<Option<f64>>>,
+}
+
+/// (name, value) pairs written as a JSON object in their order.
+struct InOrder<'a, T>(&'a [(String, T)]);
+
+impl<T: Serialize> Serialize for InOrder<'_, T> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(self.0.iter().map(|(k, v)| (k, v)))
+    }
+}
+
+/// `v` to the 7 significant digits the CSV writes (`{:.6e}`), None when not finite.
+fn seven_digits(v: f64) -> Option<f64> {
+    if v.is_finite() {
+        format!("{v:.6e}").parse().ok()
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{InOrder, seven_digits};
+
+    #[test]
+    fn json_keeps_the_order_escapes_names_and_writes_non_finite_numbers_as_null() {
+        let pairs = vec![
+            ("b \"quoted\"".to_string(), seven_digits(f64::NAN)),
+            ("a".to_string(), seven_digits(-0.605463444)),
+        ];
+        assert_eq!(
+            serde_json::to_string(&InOrder(&pairs)).unwrap(),
+            r#"{"b \"quoted\"":null,"a":-0.6054634}"#
+        );
+        assert_eq!(seven_digits(f64::NEG_INFINITY), None);
+    }
 }
