@@ -174,8 +174,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     };
     let mut recorder = match &a.record {
         Some(p) => Some(
-            shipcast::replay::Recorder::create(p, &shipcast::replay::LogInfo::of(&cfg, &sys, "simulate"))
-                .map_err(|e| anyhow::anyhow!("{e}"))?,
+            shipcast::record::Recorder::create(
+                p,
+                &shipcast::record::LogInfo::of(&cfg, &cfg.system.file, &sys, "simulate"),
+            )
+            .map_err(|e| anyhow::anyhow!("{e}"))?,
         ),
         None => None,
     };
@@ -213,7 +216,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
         } else if let Some(rec) = recorder.as_mut() {
-            use shipcast::replay::{GridRecord, MotionRecord, WavesRecord};
+            use shipcast::record::{GridRecord, MotionRecord, WavesRecord};
             let e = |e| {
                 anyhow::anyhow!(
                     "{}: {e}",

@@ -6,7 +6,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
 use shipcast::operation::{Channel, WindowScore, score_forecast_windows};
-use shipcast::replay::{self, ForecastRecord, Record};
+use shipcast::record::{self, ForecastRecord, Record};
+use shipcast::replay;
 use shipcast::skill::{self, SeriesForecast};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -79,13 +80,13 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     let mut parts = vec![];
     for p in &a.log {
         is_mcap(p)?;
-        parts.push(replay::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
+        parts.push(record::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
     }
     parts.sort_by(|x, y| {
-        let first = |r: &replay::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
+        let first = |r: &record::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
         first(x).total_cmp(&first(y))
     });
-    let mut log = replay::Read {
+    let mut log = record::Read {
         records: vec![],
         warnings: vec![],
     };
@@ -165,7 +166,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         data_s / 3600.0 / (secs / 60.0)
     );
     if let Some(p) = &a.out {
-        let mut rec = replay::Recorder::create(p, &replay::LogInfo::of(&cfg, &sys, "replay"))
+        let mut rec = record::Recorder::create(p, &record::LogInfo::of(&cfg, &cfg.system.file, &sys, "replay"))
             .map_err(|e| anyhow::anyhow!("{e}"))?;
         for f in &forecasts {
             rec.write("/forecast", f.issue_time_s, f)
@@ -604,7 +605,7 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         records.extend(f.into_iter().map(|w| (w.time_s, Record::Waves(w))));
     }
     records.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut rec = replay::Recorder::create(&a.out, &replay::LogInfo::of(&cfg, &sys, "import"))
+    let mut rec = record::Recorder::create(&a.out, &record::LogInfo::of(&cfg, &cfg.system.file, &sys, "import"))
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     for (t, r) in &records {
         rec.record(*t, r).map_err(|e| anyhow::anyhow!("{e}"))?;

@@ -18,8 +18,8 @@
 //!   constant; or given on the command line). A probe sees a long-crested sea: every `period_s` a
 //!   field is fitted to the last `window_s` of the record ([`crate::waves::observe::from_probe`]).
 
-use super::{MotionRecord, WavesRecord};
 use crate::hydro::Dof;
+use crate::record::{MotionRecord, WavesRecord};
 use crate::waves::field::heading_from_compass_deg;
 use crate::waves::observe::from_probe;
 
