@@ -159,32 +159,7 @@ impl Scenario {
                 ));
             }
         };
-        let sea_of = |s: &SeaFile, key: &str| -> Result<SeaState, Error> {
-            let spreading = match (s.spreading.as_deref(), s.spreading_s) {
-                (None, None) => Spreading::LongCrested,
-                (None, Some(e)) => Spreading::Cos2s(e),
-                (Some("cos2"), None) => Spreading::Cos2,
-                (Some(o), _) => {
-                    return Err(bad(
-                        &format!("{key}.spreading"),
-                        format!("expected \"cos2\" (or spreading_s = <s> alone), found \"{o}\""),
-                    ));
-                }
-            };
-            let sea = SeaState {
-                hs_m: s.hs_m,
-                tp_s: s.tp_s,
-                gamma: s.gamma,
-                heading_rad: s.heading_deg.to_radians(),
-                spreading,
-                components: s.components,
-                omega_min_rad_s: s.omega_min_rad_s,
-                omega_max_rad_s: s.omega_max_rad_s,
-                seed: s.seed,
-            };
-            sea::validate(&sea).map_err(|m| bad(key, m))?;
-            Ok(sea)
-        };
+        let sea_of = |sf: &SeaFile, key: &str| sea_state(sf, key).map_err(|(k, m)| bad(&k, m));
         let waves = match (raw.sea, raw.component.is_empty()) {
             (Some(s), true) => {
                 let mut seas = vec![sea_of(&s, "sea")?];
@@ -193,29 +168,7 @@ impl Scenario {
                 }
                 Waves::Sea(seas)
             }
-            (None, false) => {
-                let mut out = vec![];
-                for (k, c) in raw.component.iter().enumerate() {
-                    let ok = c.omega_rad_s.is_finite()
-                        && c.omega_rad_s > 0.0
-                        && c.heading_deg.is_finite()
-                        && c.amplitude_m.is_finite()
-                        && c.amplitude_m >= 0.0
-                        && c.phase_deg.is_finite();
-                    if !ok {
-                        return Err(bad(
-                            &format!("component[{k}]"),
-                            "needs omega_rad_s > 0, amplitude_m >= 0 and finite heading_deg, phase_deg".into(),
-                        ));
-                    }
-                    out.push(WaveComponent {
-                        omega_rad_s: c.omega_rad_s,
-                        heading_rad: c.heading_deg.to_radians(),
-                        amplitude_m: Complex64::from_polar(c.amplitude_m, c.phase_deg.to_radians()),
-                    });
-                }
-                Waves::Components(out)
-            }
+            (None, false) => Waves::Components(components(&raw.component).map_err(|(k, m)| bad(&k, m))?),
             _ => {
                 return Err(bad(
                     "sea",
@@ -239,6 +192,60 @@ impl Scenario {
             radar_radius_m: raw.radar_radius_m,
         })
     }
+}
+
+/// The sea state of table `key` (`sea`, `swell`); an error is (key, message).
+fn sea_state(s: &SeaFile, key: &str) -> Result<SeaState, (String, String)> {
+    let spreading = match (s.spreading.as_deref(), s.spreading_s) {
+        (None, None) => Spreading::LongCrested,
+        (None, Some(e)) => Spreading::Cos2s(e),
+        (Some("cos2"), None) => Spreading::Cos2,
+        (Some(o), _) => {
+            return Err((
+                format!("{key}.spreading"),
+                format!("expected \"cos2\" (or spreading_s = <s> alone), found \"{o}\""),
+            ));
+        }
+    };
+    let sea = SeaState {
+        hs_m: s.hs_m,
+        tp_s: s.tp_s,
+        gamma: s.gamma,
+        heading_rad: s.heading_deg.to_radians(),
+        spreading,
+        components: s.components,
+        omega_min_rad_s: s.omega_min_rad_s,
+        omega_max_rad_s: s.omega_max_rad_s,
+        seed: s.seed,
+    };
+    sea::validate(&sea).map_err(|m| (key.to_string(), m))?;
+    Ok(sea)
+}
+
+/// The explicit `[[component]]` entries (amplitude and phase at the origin at the start of the history);
+/// an error is (key, message).
+fn components(component: &[ComponentFile]) -> Result<Vec<WaveComponent>, (String, String)> {
+    let mut out = vec![];
+    for (k, c) in component.iter().enumerate() {
+        let ok = c.omega_rad_s.is_finite()
+            && c.omega_rad_s > 0.0
+            && c.heading_deg.is_finite()
+            && c.amplitude_m.is_finite()
+            && c.amplitude_m >= 0.0
+            && c.phase_deg.is_finite();
+        if !ok {
+            return Err((
+                format!("component[{k}]"),
+                "needs omega_rad_s > 0, amplitude_m >= 0 and finite heading_deg, phase_deg".into(),
+            ));
+        }
+        out.push(WaveComponent {
+            omega_rad_s: c.omega_rad_s,
+            heading_rad: c.heading_deg.to_radians(),
+            amplitude_m: Complex64::from_polar(c.amplitude_m, c.phase_deg.to_radians()),
+        });
+    }
+    Ok(out)
 }
 
 /// The inputs of the forecast at t0, prepared by a spin-up from rest over the history.

@@ -4,10 +4,12 @@ use super::daemon::load_config;
 use super::plot;
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use shipcast::hydro::VesselSystem;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
 use shipcast::operation::{Channel, WindowScore, score_forecast_windows};
 use shipcast::record::{self, ForecastRecord, Record};
 use shipcast::replay;
+use shipcast::service::config::ShipcastConfig;
 use shipcast::skill::{self, SeriesForecast};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -75,25 +77,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     {
         bail!("--speed {s}: must be positive");
     }
-    // several files: a recording rotated by the daemon, replayed as one, the files in the order of
-    // their first message (each file's own order is kept: it is the order the daemon saw)
-    let mut parts = vec![];
-    for p in &a.log {
-        is_mcap(p)?;
-        parts.push(record::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
-    }
-    parts.sort_by(|x, y| {
-        let first = |r: &record::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
-        first(x).total_cmp(&first(y))
-    });
-    let mut log = record::Read {
-        records: vec![],
-        warnings: vec![],
-    };
-    for part in parts {
-        log.records.extend(part.records);
-        log.warnings.extend(part.warnings);
-    }
+    let log = read_logs(&a.log)?;
     for w in &log.warnings {
         eprintln!("shipcast replay: warning: {w}");
     }
@@ -175,51 +159,89 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
     }
     if let Some(dir) = &a.report {
-        report(dir, &sys, &log.records, &forecasts, cfg.forecast.horizon_s)?;
-        let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
-        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
-        // windows are scored against the true motion when the log has it (a simulation), else the
-        // measured: IMU noise near a limit breaks windows that the motion itself kept
-        let truth = measured_series(&log.records, vessels.len(), true);
-        let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
-            (truth, "truth")
-        } else {
-            (measured_series(&log.records, vessels.len(), false), "measured")
-        };
-        windows_report(
-            dir,
-            &sys,
-            &channels,
-            cfg.operation.duration_s,
-            &forecasts,
-            &measured,
-            reference,
-        )?;
-        // issue times are on the sensors' clock (UNIX seconds), --at from its start; default: the
-        // middle forecast
+        // issue times are on the sensors' clock (UNIX seconds), --at from its start
         let t0 = if d0.is_finite() { d0 } else { t_first };
-        let ats = if a.at.is_empty() {
-            forecasts
-                .get(forecasts.len() / 2)
-                .map(|f| f.issue_time_s)
-                .into_iter()
-                .collect()
-        } else {
-            a.at.iter().map(|t| t0 + t).collect::<Vec<f64>>()
-        };
-        for at in ats {
-            if let Some(f) = forecasts
-                .iter()
-                .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
-            {
-                let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s - t0));
-                forecast_plot(&p, f, t0, &sys, &channels, &measured, reference)?;
-                println!("forecast against actual: {} (and .png)", p.display());
-            }
-        }
+        reports(dir, a, &cfg, &sys, &log.records, &forecasts, t0)?;
     }
     if a.verify {
         verify(&log.records, &forecasts)?;
+    }
+    Ok(())
+}
+
+/// The logs read and joined as one: several files are a recording rotated by the daemon, replayed in
+/// the order of their first message (each file's own order is kept: it is the order the daemon saw).
+fn read_logs(paths: &[PathBuf]) -> Result<record::Read> {
+    let mut parts = vec![];
+    for p in paths {
+        is_mcap(p)?;
+        parts.push(record::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
+    }
+    parts.sort_by(|x, y| {
+        let first = |r: &record::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
+        first(x).total_cmp(&first(y))
+    });
+    let mut log = record::Read {
+        records: vec![],
+        warnings: vec![],
+    };
+    for part in parts {
+        log.records.extend(part.records);
+        log.warnings.extend(part.warnings);
+    }
+    Ok(log)
+}
+
+/// `--report DIR`: skill against lead time, the operation's windows, and forecasts against what
+/// followed (`--at`, seconds after `t0`, the sensors' first stamp).
+fn reports(
+    dir: &Path,
+    a: &ReplayArgs,
+    cfg: &ShipcastConfig,
+    sys: &VesselSystem,
+    records: &[(f64, Record)],
+    forecasts: &[ForecastRecord],
+    t0: f64,
+) -> Result<()> {
+    report(dir, sys, records, forecasts, cfg.forecast.horizon_s)?;
+    let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
+    let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
+    // windows are scored against the true motion when the log has it (a simulation), else the
+    // measured: IMU noise near a limit breaks windows that the motion itself kept
+    let truth = measured_series(records, vessels.len(), true);
+    let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
+        (truth, "truth")
+    } else {
+        (measured_series(records, vessels.len(), false), "measured")
+    };
+    windows_report(
+        dir,
+        sys,
+        &channels,
+        cfg.operation.duration_s,
+        forecasts,
+        &measured,
+        reference,
+    )?;
+    // default: the middle forecast
+    let ats = if a.at.is_empty() {
+        forecasts
+            .get(forecasts.len() / 2)
+            .map(|f| f.issue_time_s)
+            .into_iter()
+            .collect()
+    } else {
+        a.at.iter().map(|t| t0 + t).collect::<Vec<f64>>()
+    };
+    for at in ats {
+        if let Some(f) = forecasts
+            .iter()
+            .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
+        {
+            let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s - t0));
+            forecast_plot(&p, f, t0, sys, &channels, &measured, reference)?;
+            println!("forecast against actual: {} (and .png)", p.display());
+        }
     }
     Ok(())
 }

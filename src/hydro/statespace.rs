@@ -187,6 +187,74 @@ pub fn fit_errors(
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitError(pub String);
 
+/// The fit's rows: the data (damping and added mass), then B(0) = 0 and the IRF's damping tail beyond
+/// the data (damping only: the added mass there is unknown), so the fit stays passive where the data
+/// end. Returns the frequencies and, per row, (frequency index, false).
+fn fit_rows(omegas: &[f64]) -> (Vec<f64>, Vec<(usize, bool)>) {
+    let nw = omegas.len();
+    let wn = omegas[nw - 1];
+    let mut freqs: Vec<f64> = omegas.to_vec();
+    let mut rows: Vec<(usize, bool)> = (0..nw).map(|k| (k, false)).collect();
+    // B(0) = 0 and, below the data, B linear to 0 as the convolution's IRF integrates it (the low
+    // frequencies set the zero-frequency added mass, hence the drift of modes without restoring)
+    freqs.push(0.0);
+    rows.push((nw, false));
+    for k in 1..LOW_ROWS {
+        rows.push((freqs.len(), false));
+        freqs.push(omegas[0] * k as f64 / LOW_ROWS as f64);
+    }
+    // tail nodes as dense as the data at the band's edge, spreading out by TAIL_SPREAD per node (a
+    // sparse tail lets a spurious lightly damped pole sit just above the band)
+    let mut step = (wn - omegas[nw - 2]).max(1e-3 * wn);
+    let mut x = wn + step;
+    while x <= super::radiation::TAIL_END_FACTOR * wn {
+        rows.push((freqs.len(), false));
+        freqs.push(x);
+        step *= TAIL_SPREAD;
+        x += step;
+    }
+    (freqs, rows)
+}
+
+/// The scaled kernel of each entry (i, j) of the upper triangle at each of `freqs` ([`fit_rows`]): the
+/// symmetric parts of the data, B linear to 0 below it, the damping tail above it.
+#[allow(clippy::too_many_arguments)]
+fn fit_data(
+    entries: &[(usize, usize)],
+    freqs: &[f64],
+    omegas: &[f64],
+    damping: &[DMatrix<f64>],
+    added_mass: &[DMatrix<f64>],
+    a_inf: &DMatrix<f64>,
+    tail: &DampingTail,
+    sc: &dyn Fn(usize, usize) -> f64,
+) -> Vec<Vec<Complex64>> {
+    let nw = omegas.len();
+    entries
+        .iter()
+        .map(|&(i, j)| {
+            freqs
+                .iter()
+                .enumerate()
+                .map(|(k, w)| {
+                    if k < nw {
+                        // the symmetric parts (a BEM's matrices are symmetric up to its discretization)
+                        let b = 0.5 * (damping[k][(i, j)] + damping[k][(j, i)]);
+                        let a = 0.5 * (added_mass[k][(i, j)] + added_mass[k][(j, i)]);
+                        Complex64::new(b, w * (a - a_inf[(i, j)])) / sc(i, j)
+                    } else if *w < omegas[0] {
+                        let b = 0.5 * (damping[0][(i, j)] + damping[0][(j, i)]);
+                        Complex64::new(b * w / omegas[0] / sc(i, j), 0.0)
+                    } else {
+                        let b = tail.at(*w);
+                        Complex64::new(0.5 * (b[(i, j)] + b[(j, i)]) / sc(i, j), 0.0)
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Fits the kernel K(iw) = B(w) + i w (A(w) - A_inf) at ascending `omegas` (n x n each, B passive) and
 /// returns the reduced modal model.
 pub fn fit(
@@ -215,52 +283,9 @@ pub fn fit(
     let sc = |i: usize, j: usize| (scale[i] * scale[j]).sqrt();
     // the upper triangle, scaled: entry e = (i, j), data[e][k]
     let entries: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
-    // rows: the data (damping and added mass), then B(0) = 0 and the IRF's damping tail beyond the data
-    // (damping only: the added mass there is unknown), so the fit stays passive where the data end
     let wn = omegas[nw - 1];
-    let mut freqs: Vec<f64> = omegas.to_vec();
-    let mut rows: Vec<(usize, bool)> = (0..nw).map(|k| (k, false)).collect();
-    // B(0) = 0 and, below the data, B linear to 0 as the convolution's IRF integrates it (the low
-    // frequencies set the zero-frequency added mass, hence the drift of modes without restoring)
-    freqs.push(0.0);
-    rows.push((nw, false));
-    for k in 1..LOW_ROWS {
-        rows.push((freqs.len(), false));
-        freqs.push(omegas[0] * k as f64 / LOW_ROWS as f64);
-    }
-    // tail nodes as dense as the data at the band's edge, spreading out by TAIL_SPREAD per node (a
-    // sparse tail let a spurious lightly damped pole sit just above the band on the one-ship demo)
-    let mut step = (wn - omegas[nw - 2]).max(1e-3 * wn);
-    let mut x = wn + step;
-    while x <= super::radiation::TAIL_END_FACTOR * wn {
-        rows.push((freqs.len(), false));
-        freqs.push(x);
-        step *= TAIL_SPREAD;
-        x += step;
-    }
-    let data: Vec<Vec<Complex64>> = entries
-        .iter()
-        .map(|&(i, j)| {
-            freqs
-                .iter()
-                .enumerate()
-                .map(|(k, w)| {
-                    if k < nw {
-                        // the symmetric parts (a BEM's matrices are symmetric up to its discretization)
-                        let b = 0.5 * (damping[k][(i, j)] + damping[k][(j, i)]);
-                        let a = 0.5 * (added_mass[k][(i, j)] + added_mass[k][(j, i)]);
-                        Complex64::new(b, w * (a - a_inf[(i, j)])) / sc(i, j)
-                    } else if *w < omegas[0] {
-                        let b = 0.5 * (damping[0][(i, j)] + damping[0][(j, i)]);
-                        Complex64::new(b * w / omegas[0] / sc(i, j), 0.0)
-                    } else {
-                        let b = tail.at(*w);
-                        Complex64::new(0.5 * (b[(i, j)] + b[(j, i)]) / sc(i, j), 0.0)
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let (freqs, rows) = fit_rows(omegas);
+    let data = fit_data(&entries, &freqs, omegas, damping, added_mass, a_inf, tail, &sc);
     if data.iter().flatten().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
         return Err(FitError("the damping or added mass is not finite".into()));
     }
