@@ -2,7 +2,7 @@
 //! by a measured phase-resolved wave field (see README.md, ARCHITECTURE.md and DESIGN.md).
 //!
 //! Functional core (pure, no IO, no clocks, no async): [`hydro`], [`rao`], [`rom`], [`waves`], [`sim`], [`skill`], [`operation`], [`console`].
-//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`ipc`] (iceoryx2 ports), [`replay`] (MCAP logs), [`process`] (children),
+//! Imperative shell: [`files`] and [`scenario`] (reading from disk), [`report`] (`db check`'s report), [`ipc`] (iceoryx2 ports), [`record`] (MCAP logs), [`replay`] (logs through the daemon), [`process`] (children),
 //! [`service`] (the daemon) and the `shipcast` binary.
 
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
@@ -15,7 +15,9 @@ pub mod ipc;
 pub mod operation;
 pub mod process;
 pub mod rao;
+pub mod record;
 pub mod replay;
+pub mod report;
 pub mod rom;
 pub mod scenario;
 pub mod service;

@@ -13,10 +13,8 @@
 //! components in the point's body frame for a point and in the first point's body frame for a
 //! relative motion (small rotations: all frames coincide to first order).
 
+use crate::hydro::Dof;
 use crate::hydro::external::External;
-
-/// DOF names in order.
-pub const DOF_NAMES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
 
 /// What a channel reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -117,14 +115,14 @@ pub fn resolve(name: &str, vessels: &[String], ext: &External) -> Result<Source,
         .rsplit_once('.')
         .ok_or_else(|| format!("channel \"{name}\": expected <vessel>.<dof> or <point>.<x|y|z>"))?;
     if let Some(vessel) = vessels.iter().position(|v| v == head) {
-        return DOF_NAMES
+        return Dof::NAMES
             .iter()
             .position(|d| *d == tail)
             .map(|dof| Source::Dof { vessel, dof })
             .ok_or_else(|| {
                 format!(
                     "channel \"{name}\": unknown DOF \"{tail}\" (one of {})",
-                    DOF_NAMES.join(", ")
+                    Dof::NAMES.join(", ")
                 )
             });
     }
@@ -157,7 +155,7 @@ pub fn resolve(name: &str, vessels: &[String], ext: &External) -> Result<Source,
 pub fn available(vessels: &[String], ext: &External) -> Vec<String> {
     let mut out = vec![];
     for v in vessels {
-        out.extend(DOF_NAMES.iter().map(|d| format!("{v}.{d}")));
+        out.extend(Dof::NAMES.iter().map(|d| format!("{v}.{d}")));
     }
     for n in ext
         .points

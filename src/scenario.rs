@@ -1,7 +1,8 @@
-//! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and horizon. The
+//! Forecast scenarios (`shipcast forecast SCENARIO`): a system, a sea, speed, history and length. The
 //! measured past is simulated: a model runs from rest in the same sea for `history_s` (a spin-up whose
 //! velocities become the memory and whose end state is the state at t0), then the forecasting model
-//! forecasts `horizon_s`. The past is simulated by the reference (direct convolution) whatever method
+//! forecasts for the scenario's length (key `horizon_s`, or `length_s`: the forecast's length, not a
+//! predictable horizon). The past is simulated by the reference (direct convolution) whatever method
 //! forecasts, as a measured past would not depend on it: the methods then differ only by their forecasts.
 
 use crate::files;
@@ -16,7 +17,9 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
     system: String,
-    horizon_s: f64,
+    /// The forecast's length, s (key `horizon_s`, or `length_s`).
+    #[serde(rename = "horizon_s", alias = "length_s")]
+    length_s: f64,
     history_s: f64,
     #[serde(default = "default_dt")]
     dt_s: f64,
@@ -101,7 +104,8 @@ pub enum Waves {
 #[derive(Debug, Clone)]
 pub struct Scenario {
     pub system: PathBuf,
-    pub horizon_s: f64,
+    /// The forecast's length, s (the file's `horizon_s`).
+    pub length_s: f64,
     pub history_s: f64,
     pub opts: RomOptions,
     pub waves: Waves,
@@ -122,7 +126,7 @@ impl Scenario {
             msg: format!("{k}: {m}"),
         };
         for (k, v) in [
-            ("horizon_s", raw.horizon_s),
+            ("horizon_s", raw.length_s),
             ("history_s", raw.history_s),
             ("dt_s", raw.dt_s),
         ] {
@@ -131,7 +135,7 @@ impl Scenario {
             }
         }
         // both are runs of the model, sized steps x states
-        for (k, v) in [("horizon_s", raw.horizon_s), ("history_s", raw.history_s)] {
+        for (k, v) in [("horizon_s", raw.length_s), ("history_s", raw.history_s)] {
             if v > crate::rom::forecast::MAX_FORECAST_LENGTH_S {
                 return Err(bad(
                     k,
@@ -154,32 +158,7 @@ impl Scenario {
                 ));
             }
         };
-        let sea_of = |s: &SeaFile, key: &str| -> Result<SeaState, Error> {
-            let spreading = match (s.spreading.as_deref(), s.spreading_s) {
-                (None, None) => Spreading::LongCrested,
-                (None, Some(e)) => Spreading::Cos2s(e),
-                (Some("cos2"), None) => Spreading::Cos2,
-                (Some(o), _) => {
-                    return Err(bad(
-                        &format!("{key}.spreading"),
-                        format!("expected \"cos2\" (or spreading_s = <s> alone), found \"{o}\""),
-                    ));
-                }
-            };
-            let sea = SeaState {
-                hs_m: s.hs_m,
-                tp_s: s.tp_s,
-                gamma: s.gamma,
-                heading_rad: s.heading_deg.to_radians(),
-                spreading,
-                components: s.components,
-                omega_min_rad_s: s.omega_min_rad_s,
-                omega_max_rad_s: s.omega_max_rad_s,
-                seed: s.seed,
-            };
-            sea::validate(&sea).map_err(|m| bad(key, m))?;
-            Ok(sea)
-        };
+        let sea_of = |sf: &SeaFile, key: &str| sea_state(sf, key).map_err(|(k, m)| bad(&k, m));
         let waves = match (raw.sea, raw.component.is_empty()) {
             (Some(s), true) => {
                 let mut seas = vec![sea_of(&s, "sea")?];
@@ -188,29 +167,7 @@ impl Scenario {
                 }
                 Waves::Sea(seas)
             }
-            (None, false) => {
-                let mut out = vec![];
-                for (k, c) in raw.component.iter().enumerate() {
-                    let ok = c.omega_rad_s.is_finite()
-                        && c.omega_rad_s > 0.0
-                        && c.heading_deg.is_finite()
-                        && c.amplitude_m.is_finite()
-                        && c.amplitude_m >= 0.0
-                        && c.phase_deg.is_finite();
-                    if !ok {
-                        return Err(bad(
-                            &format!("component[{k}]"),
-                            "needs omega_rad_s > 0, amplitude_m >= 0 and finite heading_deg, phase_deg".into(),
-                        ));
-                    }
-                    out.push(WaveComponent {
-                        omega_rad_s: c.omega_rad_s,
-                        heading_rad: c.heading_deg.to_radians(),
-                        amplitude_m: Complex64::from_polar(c.amplitude_m, c.phase_deg.to_radians()),
-                    });
-                }
-                Waves::Components(out)
-            }
+            (None, false) => Waves::Components(components(&raw.component).map_err(|(k, m)| bad(&k, m))?),
             _ => {
                 return Err(bad(
                     "sea",
@@ -227,13 +184,67 @@ impl Scenario {
         opts.validate().map_err(|e| bad(e.field, e.msg))?;
         Ok(Scenario {
             system: path.parent().unwrap_or(Path::new(".")).join(raw.system),
-            horizon_s: raw.horizon_s,
+            length_s: raw.length_s,
             history_s: raw.history_s,
             opts,
             waves,
             radar_radius_m: raw.radar_radius_m,
         })
     }
+}
+
+/// The sea state of table `key` (`sea`, `swell`); an error is (key, message).
+fn sea_state(s: &SeaFile, key: &str) -> Result<SeaState, (String, String)> {
+    let spreading = match (s.spreading.as_deref(), s.spreading_s) {
+        (None, None) => Spreading::LongCrested,
+        (None, Some(e)) => Spreading::Cos2s(e),
+        (Some("cos2"), None) => Spreading::Cos2,
+        (Some(o), _) => {
+            return Err((
+                format!("{key}.spreading"),
+                format!("expected \"cos2\" (or spreading_s = <s> alone), found \"{o}\""),
+            ));
+        }
+    };
+    let sea = SeaState {
+        hs_m: s.hs_m,
+        tp_s: s.tp_s,
+        gamma: s.gamma,
+        heading_rad: s.heading_deg.to_radians(),
+        spreading,
+        components: s.components,
+        omega_min_rad_s: s.omega_min_rad_s,
+        omega_max_rad_s: s.omega_max_rad_s,
+        seed: s.seed,
+    };
+    sea::validate(&sea).map_err(|m| (key.to_string(), m))?;
+    Ok(sea)
+}
+
+/// The explicit `[[component]]` entries (amplitude and phase at the origin at the start of the history);
+/// an error is (key, message).
+fn components(component: &[ComponentFile]) -> Result<Vec<WaveComponent>, (String, String)> {
+    let mut out = vec![];
+    for (k, c) in component.iter().enumerate() {
+        let ok = c.omega_rad_s.is_finite()
+            && c.omega_rad_s > 0.0
+            && c.heading_deg.is_finite()
+            && c.amplitude_m.is_finite()
+            && c.amplitude_m >= 0.0
+            && c.phase_deg.is_finite();
+        if !ok {
+            return Err((
+                format!("component[{k}]"),
+                "needs omega_rad_s > 0, amplitude_m >= 0 and finite heading_deg, phase_deg".into(),
+            ));
+        }
+        out.push(WaveComponent {
+            omega_rad_s: c.omega_rad_s,
+            heading_rad: c.heading_deg.to_radians(),
+            amplitude_m: Complex64::from_polar(c.amplitude_m, c.phase_deg.to_radians()),
+        });
+    }
+    Ok(out)
 }
 
 /// The inputs of the forecast at t0, prepared by a spin-up from rest over the history.
@@ -246,14 +257,14 @@ pub struct Prepared {
 }
 
 impl Prepared {
-    /// The forecast request from this state, over `horizon_s`.
-    pub fn request(&self, horizon_s: f64) -> ForecastRequest<'_> {
+    /// The forecast request from this state, `length_s` long.
+    pub fn request(&self, length_s: f64) -> ForecastRequest<'_> {
         ForecastRequest {
             x0: &self.x0,
             v0: &self.v0,
             memory: &self.memory,
             waves: &self.waves,
-            horizon_s,
+            horizon_s: length_s,
             ramp_s: 0.0,
         }
     }

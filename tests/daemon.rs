@@ -525,7 +525,7 @@ fn a_python_console_decodes_a_live_forecast() {
 
 #[test]
 fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
-    use shipcast::replay::{Record, read};
+    use shipcast::record::{Record, read};
     let dir = crate::util::scratch_dir("daemon-record");
     let rec_dir = dir.join("logs");
     let cfg = config(&dir, "record", &format!("[record]\ndir = \"{}\"\n", rec_dir.display()));
@@ -540,7 +540,7 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
         .collect();
     assert_eq!(logs.len(), 1, "{logs:?}");
-    let forecasts_of = |p: &Path| -> Vec<shipcast::replay::ForecastRecord> {
+    let forecasts_of = |p: &Path| -> Vec<shipcast::record::ForecastRecord> {
         read(p)
             .unwrap()
             .records

@@ -48,8 +48,18 @@ fn json_forecast_to_a_file() {
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&out_path).unwrap();
     let _ = std::fs::remove_file(&out_path);
+    let v: serde_json::Value =
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {}", &text[..120.min(text.len())]));
+    assert_eq!(v["dt_s"], 0.1);
+    assert_eq!(v["horizon_s"], 60.0);
     assert!(
-        text.starts_with("{\"dt_s\":0.1,\"horizon_s\":60,") && text.contains("\"carrier.heave_m\":["),
+        v["motion"]["carrier.heave_m"].is_array(),
+        "{}",
+        &text[..120.min(text.len())]
+    );
+    // the object's keys in the order they are written
+    assert!(
+        text.starts_with("{\"dt_s\":0.1,\"horizon_s\":60.0,\"predictable_horizon_s\":"),
         "{}",
         &text[..120.min(text.len())]
     );

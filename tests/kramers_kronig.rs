@@ -3,7 +3,8 @@
 //! (WAMIT). Errors are max over w <= 0.8 w_max of |A_K - A| / sqrt(max|A_ii| max|A_jj|).
 
 use shipcast::files::load_system;
-use shipcast::hydro::check::{choose_a_inf, system_irf};
+use shipcast::hydro::check::choose_a_inf;
+use shipcast::hydro::memory::system_irf;
 use shipcast::hydro::radiation::{kramers_kronig, ogilvie_a_inf, ogilvie_estimates};
 use shipcast::hydro::system::TailChoice;
 use shipcast::hydro::{Dof, VesselSystem};

@@ -48,7 +48,7 @@ fn simulated_log(dir: &Path, secs: u32) -> (PathBuf, PathBuf) {
 fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
     let dir = scratch_dir("replay-skill");
     let (cfg, log) = simulated_log(&dir, 600);
-    let run = |name: &str| -> (serde_json::Value, Vec<shipcast::replay::ForecastRecord>) {
+    let run = |name: &str| -> (serde_json::Value, Vec<shipcast::record::ForecastRecord>) {
         let rep = dir.join(name);
         let out = dir.join(format!("{name}.mcap"));
         let (ok, stdout, err) = shipcast(&[
@@ -129,12 +129,12 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
                 "trusted horizon",
             ],
         );
-        let forecasts: Vec<shipcast::replay::ForecastRecord> = shipcast::replay::read(&out)
+        let forecasts: Vec<shipcast::record::ForecastRecord> = shipcast::record::read(&out)
             .unwrap()
             .records
             .into_iter()
             .filter_map(|(_, r)| match r {
-                shipcast::replay::Record::Forecast(f) => Some(f),
+                shipcast::record::Record::Forecast(f) => Some(f),
                 _ => None,
             })
             .collect();
@@ -269,7 +269,7 @@ fn damaged_logs_keep_what_is_readable_and_newer_schemas_are_refused() {
 
 #[test]
 fn logs_rotate_by_log_time_and_every_message_is_kept() {
-    use shipcast::replay::{LogInfo, MotionRecord, Record, RotatingRecorder, read};
+    use shipcast::record::{LogInfo, MotionRecord, Record, RotatingRecorder, read};
     let dir = scratch_dir("rotate-time");
     let mut r = RotatingRecorder::new(&dir, 1000.0, Some(10.0), LogInfo::default()).unwrap();
     for k in 0..350 {
@@ -306,7 +306,7 @@ const PROBE_MIN_CORRELATION_10S: f64 = 0.8;
 
 #[test]
 fn csv_recordings_import_and_replay_without_code() {
-    use shipcast::replay::{Record, read};
+    use shipcast::record::{Record, read};
     let dir = scratch_dir("import");
     let (cfg, log) = simulated_log(&dir, 400);
     let records = read(&log).unwrap().records;
@@ -567,7 +567,7 @@ fn a_corrupt_chunk_header_is_read_up_to_the_damage_in_bounded_time() {
 
 #[test]
 fn a_log_time_gap_replays_in_time_proportional_to_its_messages() {
-    use shipcast::replay::{LogInfo, MotionRecord, Record, Recorder, read};
+    use shipcast::record::{LogInfo, MotionRecord, Record, Recorder, read};
     let dir = scratch_dir("replay-gap");
     let (cfg, log) = v1_fixture();
     let mut records = read(&log).unwrap().records;
@@ -598,7 +598,7 @@ fn a_log_time_gap_replays_in_time_proportional_to_its_messages() {
 
 #[test]
 fn a_version_1_log_still_replays_to_the_same_forecasts() {
-    use shipcast::replay::{ForecastRecord, Record, read};
+    use shipcast::record::{ForecastRecord, Record, read};
     let dir = scratch_dir("replay-v1");
     let (cfg, log) = v1_fixture();
     let out = dir.join("replayed.mcap");

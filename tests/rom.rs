@@ -278,7 +278,7 @@ fn two_ship_forecasts_from_the_same_past_agree() {
     let run = |m: &TimeModel| {
         let prep = prepare(&past, m, &sc.waves, sc.history_s).unwrap();
         Forecaster::new()
-            .forecast(m, &prep.request(sc.horizon_s))
+            .forecast(m, &prep.request(sc.length_s))
             .unwrap()
             .clone()
     };

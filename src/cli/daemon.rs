@@ -174,8 +174,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     };
     let mut recorder = match &a.record {
         Some(p) => Some(
-            shipcast::replay::Recorder::create(p, &shipcast::replay::LogInfo::of(&cfg, &sys, "simulate"))
-                .map_err(|e| anyhow::anyhow!("{e}"))?,
+            shipcast::record::Recorder::create(
+                p,
+                &shipcast::record::LogInfo::of(&cfg, &cfg.system.file, &sys, "simulate"),
+            )
+            .map_err(|e| anyhow::anyhow!("{e}"))?,
         ),
         None => None,
     };
@@ -213,58 +216,13 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
         } else if let Some(rec) = recorder.as_mut() {
-            use shipcast::replay::{GridRecord, MotionRecord, WavesRecord};
-            let e = |e| {
-                anyhow::anyhow!(
-                    "{}: {e}",
-                    a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
-                )
-            };
-            if next_radar <= next_imu {
-                let field = sim.radar(t);
-                if grid_every > 0
-                    && scans.is_multiple_of(grid_every as u64)
-                    && let Some(g) = sim.last_grid()
-                {
-                    let grid = GridRecord::elevation(&g.x_m, &g.y_m, &g.values, t + epoch);
-                    rec.write("/radar", t + epoch, &grid).map_err(e)?;
-                }
-                scans += 1;
-                if let Some(mut f) = field {
-                    f.time_s += epoch;
-                    rec.write("/waves", t + epoch, &WavesRecord::of(&f)).map_err(e)?;
-                }
+            let radar = next_radar <= next_imu;
+            let at = a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+            record_step(rec, &mut sim, t, epoch, radar, (grid_every, &mut scans))
+                .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+            if radar {
                 next_radar += radar_dt;
                 continue;
-            }
-            let stamp = t + epoch;
-            for s in sim.imu(t) {
-                rec.write(
-                    "/motion",
-                    stamp,
-                    &MotionRecord {
-                        vessel: s.vessel as u32,
-                        time_s: stamp,
-                        x: s.x,
-                        v: s.v,
-                    },
-                )
-                .map_err(e)?;
-                let mut x = [0.0; 6];
-                for (d, xd) in x.iter_mut().enumerate() {
-                    *xd = sim.true_x(t, 6 * s.vessel + d);
-                }
-                rec.write(
-                    "/truth",
-                    stamp,
-                    &MotionRecord {
-                        vessel: s.vessel as u32,
-                        time_s: stamp,
-                        x,
-                        v: [0.0; 6],
-                    },
-                )
-                .map_err(e)?;
             }
         } else if next_radar <= next_imu {
             next_radar += radar_dt;
@@ -289,6 +247,63 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
             "shipcast simulate: {duration} s recorded in {:.1} s",
             t.elapsed().as_secs_f64()
         );
+    }
+    Ok(())
+}
+
+/// Records the simulator's output at `t` (log time `t + epoch`): with `radar`, a scan's field and, every
+/// `grid_every` scans (counted in `scans`), its elevation grid; else the IMU samples and the true motion.
+fn record_step(
+    rec: &mut shipcast::record::Recorder<std::io::BufWriter<std::fs::File>>,
+    sim: &mut Simulation,
+    t: f64,
+    epoch: f64,
+    radar: bool,
+    (grid_every, scans): (u32, &mut u64),
+) -> std::result::Result<(), shipcast::record::Error> {
+    use shipcast::record::{GridRecord, MotionRecord, WavesRecord};
+    if radar {
+        let field = sim.radar(t);
+        if grid_every > 0
+            && scans.is_multiple_of(u64::from(grid_every))
+            && let Some(g) = sim.last_grid()
+        {
+            let grid = GridRecord::elevation(&g.x_m, &g.y_m, &g.values, t + epoch);
+            rec.write("/radar", t + epoch, &grid)?;
+        }
+        *scans += 1;
+        if let Some(mut f) = field {
+            f.time_s += epoch;
+            rec.write("/waves", t + epoch, &WavesRecord::of(&f))?;
+        }
+        return Ok(());
+    }
+    let stamp = t + epoch;
+    for s in sim.imu(t) {
+        rec.write(
+            "/motion",
+            stamp,
+            &MotionRecord {
+                vessel: s.vessel as u32,
+                time_s: stamp,
+                x: s.x,
+                v: s.v,
+            },
+        )?;
+        let mut x = [0.0; 6];
+        for (d, xd) in x.iter_mut().enumerate() {
+            *xd = sim.true_x(t, 6 * s.vessel + d);
+        }
+        rec.write(
+            "/truth",
+            stamp,
+            &MotionRecord {
+                vessel: s.vessel as u32,
+                time_s: stamp,
+                x,
+                v: [0.0; 6],
+            },
+        )?;
     }
     Ok(())
 }
@@ -516,7 +531,6 @@ pub struct DemoArgs {
 /// skill so far: the forecasts of 30 s ago against the motion measured now). Ctrl-C (or q in the
 /// console) stops all three.
 pub fn demo(a: &DemoArgs) -> Result<()> {
-    use shipcast::ipc::MotionSubscriber;
     use shipcast::process::Interrupting;
     let cfg = load_config(&a.config)?;
     let sys = load_system(&cfg)?;
@@ -567,7 +581,19 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
         );
         return r;
     }
-    let wanted_s = shipcast::service::history_wanted_s(&cfg, &sys);
+    plain_demo(&cfg, &sys, a.seconds, &stop)
+}
+
+/// `demo` without the console: a line per forecast with its skill so far (the forecasts of 30 s ago
+/// against the motion measured now), until `stop` or `seconds`.
+fn plain_demo(
+    cfg: &ShipcastConfig,
+    sys: &shipcast::hydro::VesselSystem,
+    seconds: Option<f64>,
+    stop: &AtomicBool,
+) -> Result<()> {
+    use shipcast::ipc::MotionSubscriber;
+    let wanted_s = shipcast::service::history_wanted_s(cfg, sys);
     let mut first_motion_s: Option<f64> = None;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
@@ -583,7 +609,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     let start = Instant::now();
     let name0 = sys.spec.bodies[0].name.clone();
     while !stop.load(std::sync::atomic::Ordering::Relaxed) {
-        if a.seconds.is_some_and(|s| start.elapsed().as_secs_f64() > s) {
+        if seconds.is_some_and(|s| start.elapsed().as_secs_f64() > s) {
             break;
         }
         got.clear();

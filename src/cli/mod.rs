@@ -3,8 +3,10 @@
 
 pub mod console;
 pub mod daemon;
+pub mod forecast;
 pub mod horizon;
 pub mod plot;
+pub mod rao;
 pub mod replay;
 
 use std::path::PathBuf;
@@ -58,6 +60,25 @@ pub fn utc(unix_s: f64) -> String {
         t.second(),
         t.millisecond() / 100
     )
+}
+
+/// `--radiation`: the radiation memory of the time-domain model.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Radiation {
+    /// Direct convolution of the impulse response with the velocity history.
+    Convolution,
+    /// The passive state-space fit.
+    StateSpace,
+}
+
+impl From<Radiation> for shipcast::rom::RadiationMethod {
+    fn from(r: Radiation) -> Self {
+        use shipcast::rom::RadiationMethod;
+        match r {
+            Radiation::Convolution => RadiationMethod::Convolution,
+            Radiation::StateSpace => RadiationMethod::StateSpace,
+        }
+    }
 }
 
 #[cfg(test)]

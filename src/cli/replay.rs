@@ -4,9 +4,12 @@ use super::daemon::load_config;
 use super::plot;
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use shipcast::hydro::VesselSystem;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
 use shipcast::operation::{Channel, WindowScore, score_forecast_windows};
-use shipcast::replay::{self, ForecastRecord, Record};
+use shipcast::record::{self, ForecastRecord, Record};
+use shipcast::replay;
+use shipcast::service::config::ShipcastConfig;
 use shipcast::skill::{self, SeriesForecast};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -48,8 +51,6 @@ pub struct ReplayArgs {
     at: Vec<f64>,
 }
 
-const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
-
 /// MCAP's magic number, the first and last 8 bytes of every MCAP file.
 const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
 
@@ -76,25 +77,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
     {
         bail!("--speed {s}: must be positive");
     }
-    // several files: a recording rotated by the daemon, replayed as one, the files in the order of
-    // their first message (each file's own order is kept: it is the order the daemon saw)
-    let mut parts = vec![];
-    for p in &a.log {
-        is_mcap(p)?;
-        parts.push(replay::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
-    }
-    parts.sort_by(|x, y| {
-        let first = |r: &replay::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
-        first(x).total_cmp(&first(y))
-    });
-    let mut log = replay::Read {
-        records: vec![],
-        warnings: vec![],
-    };
-    for part in parts {
-        log.records.extend(part.records);
-        log.warnings.extend(part.warnings);
-    }
+    let log = read_logs(&a.log)?;
     for w in &log.warnings {
         eprintln!("shipcast replay: warning: {w}");
     }
@@ -167,7 +150,7 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         data_s / 3600.0 / (secs / 60.0)
     );
     if let Some(p) = &a.out {
-        let mut rec = replay::Recorder::create(p, &replay::LogInfo::of(&cfg, &sys, "replay"))
+        let mut rec = record::Recorder::create(p, &record::LogInfo::of(&cfg, &cfg.system.file, &sys, "replay"))
             .map_err(|e| anyhow::anyhow!("{e}"))?;
         for f in &forecasts {
             rec.write("/forecast", f.issue_time_s, f)
@@ -176,52 +159,90 @@ pub fn run(a: &ReplayArgs) -> Result<()> {
         rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
     }
     if let Some(dir) = &a.report {
-        let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
-        // forecasts are scored against the true motion when the log has it (a simulation), else the
-        // measured: the sensor's noise and bias are not the vessel's motion, and IMU noise near a
-        // limit breaks windows that the motion itself kept
-        let truth = measured_series(&log.records, vessels.len(), true);
-        let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
-            (truth, "truth")
-        } else {
-            (measured_series(&log.records, vessels.len(), false), "measured")
-        };
-        report(dir, &sys, &measured, reference, &forecasts, cfg.forecast.horizon_s)?;
-        let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
-        windows_report(
-            dir,
-            &sys,
-            &channels,
-            cfg.operation.duration_s,
-            &forecasts,
-            &measured,
-            reference,
-        )?;
-        // issue times are on the sensors' clock (UNIX seconds), --at from its start; default: the
-        // middle forecast
+        // issue times are on the sensors' clock (UNIX seconds), --at from its start
         let t0 = if d0.is_finite() { d0 } else { t_first };
-        let ats = if a.at.is_empty() {
-            forecasts
-                .get(forecasts.len() / 2)
-                .map(|f| f.issue_time_s)
-                .into_iter()
-                .collect()
-        } else {
-            a.at.iter().map(|t| t0 + t).collect::<Vec<f64>>()
-        };
-        for at in ats {
-            if let Some(f) = forecasts
-                .iter()
-                .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
-            {
-                let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s - t0));
-                forecast_plot(&p, f, t0, &sys, &channels, &measured, reference)?;
-                println!("forecast against actual: {} (and .png)", p.display());
-            }
-        }
+        reports(dir, a, &cfg, &sys, &log.records, &forecasts, t0)?;
     }
     if a.verify {
         verify(&log.records, &forecasts)?;
+    }
+    Ok(())
+}
+
+/// The logs read and joined as one: several files are a recording rotated by the daemon, replayed in
+/// the order of their first message (each file's own order is kept: it is the order the daemon saw).
+fn read_logs(paths: &[PathBuf]) -> Result<record::Read> {
+    let mut parts = vec![];
+    for p in paths {
+        is_mcap(p)?;
+        parts.push(record::read(p).map_err(|e| anyhow::anyhow!("{e}"))?);
+    }
+    parts.sort_by(|x, y| {
+        let first = |r: &record::Read| r.records.first().map_or(f64::INFINITY, |m| m.0);
+        first(x).total_cmp(&first(y))
+    });
+    let mut log = record::Read {
+        records: vec![],
+        warnings: vec![],
+    };
+    for part in parts {
+        log.records.extend(part.records);
+        log.warnings.extend(part.warnings);
+    }
+    Ok(log)
+}
+
+/// `--report DIR`: skill against lead time, the operation's windows, and forecasts against what
+/// followed (`--at`, seconds after `t0`, the sensors' first stamp).
+fn reports(
+    dir: &Path,
+    a: &ReplayArgs,
+    cfg: &ShipcastConfig,
+    sys: &VesselSystem,
+    records: &[(f64, Record)],
+    forecasts: &[ForecastRecord],
+    t0: f64,
+) -> Result<()> {
+    let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
+    // forecasts are scored against the true motion when the log has it (a simulation), else the
+    // measured: the sensor's noise and bias are not the vessel's motion, and IMU noise near a limit
+    // breaks windows that the motion itself kept
+    let truth = measured_series(records, vessels.len(), true);
+    let (measured, reference) = if truth.iter().any(|s| !s.is_empty()) {
+        (truth, "truth")
+    } else {
+        (measured_series(records, vessels.len(), false), "measured")
+    };
+    report(dir, sys, &measured, reference, forecasts, cfg.forecast.horizon_s)?;
+    let channels = cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
+    windows_report(
+        dir,
+        sys,
+        &channels,
+        cfg.operation.duration_s,
+        forecasts,
+        &measured,
+        reference,
+    )?;
+    // default: the middle forecast
+    let ats = if a.at.is_empty() {
+        forecasts
+            .get(forecasts.len() / 2)
+            .map(|f| f.issue_time_s)
+            .into_iter()
+            .collect()
+    } else {
+        a.at.iter().map(|t| t0 + t).collect::<Vec<f64>>()
+    };
+    for at in ats {
+        if let Some(f) = forecasts
+            .iter()
+            .min_by(|x, y| (x.issue_time_s - at).abs().total_cmp(&(y.issue_time_s - at).abs()))
+        {
+            let p = dir.join(format!("forecast-{:.0}.svg", f.issue_time_s - t0));
+            forecast_plot(&p, f, t0, sys, &channels, &measured, reference)?;
+            println!("forecast against actual: {} (and .png)", p.display());
+        }
     }
     Ok(())
 }
@@ -455,7 +476,7 @@ fn report(
     measured_all: &[Vec<(f64, f64)>],
     reference: &str,
     forecasts: &[ForecastRecord],
-    horizon_s: f64,
+    length_s: f64,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let nb = sys.spec.bodies.len();
@@ -467,7 +488,7 @@ fn report(
     for b in 0..nb {
         let name = &sys.spec.bodies[b].name;
         let mut dofs = vec![];
-        for (d, dof) in DOFS.iter().enumerate() {
+        for (d, dof) in shipcast::hydro::Dof::NAMES.iter().enumerate() {
             let measured = &measured_all[6 * b + d];
             let fs: Vec<SeriesForecast> = forecasts
                 .iter()
@@ -481,7 +502,7 @@ fn report(
                     }
                 })
                 .collect();
-            let sk = skill::score(&fs, measured, step, horizon_s);
+            let sk = skill::score(&fs, measured, step, length_s);
             lead = sk.lead_s.clone();
             let arr = |v: &[f64]| {
                 v.iter()
@@ -608,7 +629,7 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         records.extend(f.into_iter().map(|w| (w.time_s, Record::Waves(w))));
     }
     records.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut rec = replay::Recorder::create(&a.out, &replay::LogInfo::of(&cfg, &sys, "import"))
+    let mut rec = record::Recorder::create(&a.out, &record::LogInfo::of(&cfg, &cfg.system.file, &sys, "import"))
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     for (t, r) in &records {
         rec.record(*t, r).map_err(|e| anyhow::anyhow!("{e}"))?;

@@ -1,10 +1,13 @@
 //! Database checks behind `shipcast db check` (pure): natural periods, negative damping, the
-//! Kramers-Kronig consistency of A(w), B(w) and A_inf.
+//! Kramers-Kronig consistency of A(w), B(w) and A_inf, the asymmetry and passivity of the database, and
+//! the state-space fit's errors. The radiation memory they check is built in [`super::memory`], as the
+//! time-domain models build it.
 
-use super::modal;
+use super::VesselSystem;
+use super::memory::{RadiationMemory, active_radiation, system_memory};
 use super::radiation::{self, DampingTail, Irf, PairError};
-use super::system::{AInfSource, TailChoice};
-use super::{Dof, VesselSystem};
+use super::statespace;
+use super::system::AInfSource;
 use nalgebra::DMatrix;
 
 /// What `db check` reports.
@@ -68,119 +71,16 @@ pub fn choose_a_inf(sys: &VesselSystem, irf: &Irf) -> (DMatrix<f64>, AInfSource)
     }
 }
 
-/// The radiation memory the time-domain models use: K(t) on t = 0, dt, ..., duration from the
-/// database's damping made passive and the damping tail the system file asks for (fitted to the BEM's
-/// A_inf unless `irf.tail = "cubic"` or the database has none).
-#[derive(Debug, Clone)]
-pub struct RadiationMemory {
-    pub irf: Irf,
-    pub tail: DampingTail,
-    /// The fit's worst added-mass residual in band (cubic tail, fitted tail), when fitted.
-    pub fit_residuals: Option<(f64, f64)>,
-}
-
-pub fn radiation_memory(sys: &VesselSystem, dt_s: f64, duration_s: f64) -> RadiationMemory {
-    let (b, _) = radiation::passive_damping(&sys.db.damping);
-    radiation_memory_of(sys, &b, dt_s, duration_s)
-}
-
-/// The same from the given damping samples (at the database's frequencies).
-pub fn radiation_memory_of(sys: &VesselSystem, b: &[DMatrix<f64>], dt_s: f64, duration_s: f64) -> RadiationMemory {
-    let db = &sys.db;
-    match (sys.spec.irf.tail, &db.added_mass_inf) {
-        (TailChoice::Fitted, Some(a_inf)) => {
-            let fit = radiation::fit_tail(&db.omega_rad_s, b, &db.added_mass, a_inf, dt_s, duration_s);
-            RadiationMemory {
-                irf: fit.irf,
-                tail: fit.tail,
-                fit_residuals: Some((fit.residual_cubic, fit.residual_fitted)),
-            }
-        }
-        _ => {
-            let tail = DampingTail::cubic(&db.omega_rad_s, b);
-            RadiationMemory {
-                irf: radiation::impulse_response_of(&db.omega_rad_s, b, &tail, dt_s, duration_s),
-                tail,
-                fit_residuals: None,
-            }
-        }
-    }
-}
-
-/// The active DOFs' passive damping, added mass, A_inf and damping tail (the inputs of the radiation
-/// models).
-pub struct ActiveRadiation {
-    pub damping: Vec<DMatrix<f64>>,
-    pub added_mass: Vec<DMatrix<f64>>,
-    pub a_inf: DMatrix<f64>,
-    pub tail: DampingTail,
-}
-
-impl ActiveRadiation {
-    /// The state-space fit of this radiation ([`modal::fit`]) at the database's frequencies `omegas`.
-    pub fn fit(&self, omegas: &[f64], opts: modal::ModalOptions) -> Result<modal::ModalModel, modal::FitError> {
-        modal::fit(omegas, &self.damping, &self.added_mass, &self.a_inf, &self.tail, opts)
-    }
-}
-
-pub fn active_radiation(sys: &VesselSystem, a_inf: &DMatrix<f64>, tail: &DampingTail) -> ActiveRadiation {
-    let act = sys.active_indices();
-    let sub = |m: &DMatrix<f64>| DMatrix::from_fn(act.len(), act.len(), |r, c| m[(act[r], act[c])]);
-    let b: Vec<DMatrix<f64>> = sys.db.damping.iter().map(sub).collect();
-    let (b, _) = radiation::passive_damping(&b);
-    ActiveRadiation {
-        damping: b,
-        added_mass: sys.db.added_mass.iter().map(sub).collect(),
-        a_inf: sub(a_inf),
-        tail: tail.sub(&act),
-    }
-}
-
-/// A_inf as the time-domain models use it: the database's when the system file asks for it, else
-/// Ogilvie's estimate from `irf` (consistent with the damping as the model sees it).
-pub fn model_a_inf(sys: &VesselSystem, irf: &Irf) -> DMatrix<f64> {
-    match (sys.spec.a_inf, &sys.db.added_mass_inf) {
-        (Some(AInfSource::Database), Some(a)) => a.clone(),
-        _ => radiation::ogilvie_a_inf(&radiation::ogilvie_estimates(&sys.db, irf)),
-    }
-}
-
-/// The memory the state-space model is fitted from (the time-domain model and `db check` both call
-/// this): the passive damping on the system file's IRF grid, never the solver's step.
-pub fn state_space_memory(sys: &VesselSystem, duration_s: f64) -> RadiationMemory {
-    radiation_memory(sys, sys.spec.irf.dt_s, duration_s)
-}
-
-/// The memory length the system file asks for (`irf.duration_s`), or the database's default
-/// ([`radiation::default_duration_s`]).
-pub fn memory_duration_s(sys: &VesselSystem) -> f64 {
-    sys.spec
-        .irf
-        .duration_s
-        .unwrap_or_else(|| radiation::default_duration_s(&sys.db))
-}
-
 /// The (damping, added mass) errors of a state-space model of the active DOFs' radiation (see
-/// [`modal::fit_errors`]), the added mass against the given A_inf.
+/// [`statespace::fit_errors`]), the added mass against the given A_inf.
 pub fn state_space_errors(
     sys: &VesselSystem,
-    model: &modal::ModalModel,
+    model: &statespace::ModalModel,
     a_inf: &DMatrix<f64>,
     tail: &DampingTail,
 ) -> (f64, f64) {
     let r = active_radiation(sys, a_inf, tail);
-    modal::fit_errors(model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf)
-}
-
-/// The memory of the database as it is (its damping not made passive, so the checks see the BEM's
-/// data), with the configured (or default) time grid and damping tail.
-pub fn system_memory(sys: &VesselSystem) -> RadiationMemory {
-    radiation_memory_of(sys, &sys.db.damping, sys.spec.irf.dt_s, memory_duration_s(sys))
-}
-
-/// The IRF of [`system_memory`].
-pub fn system_irf(sys: &VesselSystem) -> Irf {
-    system_memory(sys).irf
+    statespace::fit_errors(model, &sys.db.omega_rad_s, &r.damping, &r.added_mass, &r.a_inf)
 }
 
 pub fn check(sys: &VesselSystem) -> CheckReport {
@@ -227,36 +127,6 @@ pub fn check(sys: &VesselSystem) -> CheckReport {
         asymmetry_added_mass: asymmetry(&db.added_mass),
         asymmetry_damping: asymmetry(&db.damping),
         passivity_repair: radiation::passive_damping(&db.damping).1,
-    }
-}
-
-/// `carrier.heave` style label of a 0-based global mode index.
-pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
-    if i >= sys.n_modes() {
-        let k = i - sys.n_modes();
-        let name = sys.spec.external.tank_names.get(k).map(|s| s.as_str()).unwrap_or("?");
-        return format!("{name}.tank_angle");
-    }
-    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
-    format!("{body}.{}", Dof::of_index(i).name())
-}
-
-/// The output column of state `i` with its unit (`carrier.heave_m`, `carrier.roll_deg`,
-/// `<tank>.tank_angle_deg`), as CSV and JSON outputs write it; [`output_value`] converts the value.
-pub fn output_label(sys: &VesselSystem, i: usize) -> String {
-    if i >= sys.n_modes() {
-        return format!("{}_deg", mode_label(sys, i));
-    }
-    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
-    format!("{body}.{}", Dof::of_index(i).output_name())
-}
-
-/// State `i`'s value (m or rad) in the unit of its [`output_label`] (m or deg; a tank angle in deg).
-pub fn output_value(sys: &VesselSystem, i: usize, si: f64) -> f64 {
-    if i >= sys.n_modes() {
-        si.to_degrees()
-    } else {
-        Dof::of_index(i).to_output(si)
     }
 }
 

@@ -767,33 +767,10 @@ pub(crate) fn parse_external(
     body_positions_m: Vec<Vector3<f64>>,
     g_m_s2: f64,
 ) -> Result<External, KeyErr> {
-    let body_of = |name: &str, key: &str, earth: bool| -> Result<Option<usize>, KeyErr> {
-        if earth && name == "earth" {
-            return Ok(None);
-        }
-        body_names.iter().position(|b| b == name).map(Some).ok_or_else(|| {
-            (
-                key.into(),
-                format!(
-                    "names no body: `{name}` (bodies: {}{})",
-                    body_names.join(", "),
-                    if earth { ", or \"earth\"" } else { "" }
-                ),
-            )
-        })
-    };
+    let body_of = |name: &str, key: &str, earth: bool| body_of(body_names, name, key, earth);
     let mut out = External {
         body_positions_m,
         ..External::default()
-    };
-    let unique = |names: &[&str], name: &str, key: &str| -> Result<(), KeyErr> {
-        if name.trim().is_empty() {
-            return Err((key.into(), "must not be empty".into()));
-        }
-        if names.contains(&name) {
-            return Err((key.into(), format!("`{name}` is used twice")));
-        }
-        Ok(())
     };
     for (k, c) in connections.iter().enumerate() {
         let at = format!("connection[{k}]");
@@ -813,115 +790,7 @@ pub(crate) fn parse_external(
         if a.body.is_some() && a.body == b.body {
             return Err((format!("{at}.body_b"), "connects a body to itself".into()));
         }
-        let curve = |range: f64| -> Result<Curve, KeyErr> {
-            let cv = match (&c.curve, &c.tension_polynomial) {
-                (Some(t), None) => Curve::Table(t.iter().map(|p| (p[0], p[1])).collect()),
-                (None, Some(p)) => Curve::Polynomial(p.clone()),
-                (Some(_), Some(_)) => {
-                    return Err((
-                        format!("{at}.curve"),
-                        "give `curve` or `tension_polynomial`, not both".into(),
-                    ));
-                }
-                (None, None) => return Err((format!("{at}.curve"), "is required".into())),
-            };
-            cv.validate(range).map_err(|m| (format!("{at}.curve"), m))?;
-            Ok(cv)
-        };
-        let kind = match c.kind.as_str() {
-            "spring_damper" => {
-                only(c, &at, &["axis", "stiffness_n_m", "damping_n_s_m", "pretension_n"])?;
-                let axis = c.axis.map(|v| unit(v, &format!("{at}.axis"))).transpose()?;
-                if axis.is_none() {
-                    let d = out.rest_position(&b) - out.rest_position(&a);
-                    if d.norm() < 1e-6 {
-                        return Err((
-                            format!("{at}.axis"),
-                            "the two points coincide: give the spring's axis".into(),
-                        ));
-                    }
-                }
-                ConnectionKind::SpringDamper {
-                    axis,
-                    stiffness_n_m: nonneg(c.stiffness_n_m, &format!("{at}.stiffness_n_m"))?,
-                    damping_n_s_m: nonneg(c.damping_n_s_m, &format!("{at}.damping_n_s_m"))?,
-                    pretension_n: nonneg(c.pretension_n, &format!("{at}.pretension_n"))?,
-                }
-            }
-            "bushing" => {
-                only(c, &at, &["stiffness", "damping"])?;
-                let six = |v: Option<[f64; 6]>, key: &str| -> Result<[f64; 6], KeyErr> {
-                    let v = v.unwrap_or([0.0; 6]);
-                    for (i, x) in v.iter().enumerate() {
-                        if !(x.is_finite() && *x >= 0.0) {
-                            return Err((
-                                format!("{at}.{key}[{i}]"),
-                                format!("must be finite and >= 0, found {x}"),
-                            ));
-                        }
-                    }
-                    Ok(v)
-                };
-                ConnectionKind::Bushing {
-                    stiffness: six(c.stiffness, "stiffness")?,
-                    damping: six(c.damping, "damping")?,
-                }
-            }
-            "mooring_line" => {
-                only(
-                    c,
-                    &at,
-                    &["curve", "tension_polynomial", "unstretched_length_m", "damping_n_s_m"],
-                )?;
-                let l0 = positive(c.unstretched_length_m, &format!("{at}.unstretched_length_m"))?;
-                ConnectionKind::MooringLine {
-                    curve: curve(l0)?,
-                    unstretched_length_m: l0,
-                    damping_n_s_m: nonneg(c.damping_n_s_m, &format!("{at}.damping_n_s_m"))?,
-                }
-            }
-            "fender" => {
-                only(
-                    c,
-                    &at,
-                    &[
-                        "curve",
-                        "normal",
-                        "initial_compression_m",
-                        "friction_coefficient",
-                        "friction_velocity_m_s",
-                    ],
-                )?;
-                if c.tension_polynomial.is_some() {
-                    return Err((
-                        format!("{at}.tension_polynomial"),
-                        "fenders take a `curve` table".into(),
-                    ));
-                }
-                let normal = match c.normal {
-                    Some(v) => unit(v, &format!("{at}.normal"))?,
-                    None => return Err((format!("{at}.normal"), "is required".into())),
-                };
-                let mu = nonneg(c.friction_coefficient, &format!("{at}.friction_coefficient"))?;
-                let vref = match c.friction_velocity_m_s {
-                    None => 0.01,
-                    v => positive(v, &format!("{at}.friction_velocity_m_s"))?,
-                };
-                ConnectionKind::Fender {
-                    curve: curve(1.0)?,
-                    normal,
-                    initial_compression_m: nonneg(c.initial_compression_m, &format!("{at}.initial_compression_m"))?,
-                    friction_coefficient: mu,
-                    friction_velocity_m_s: vref,
-                }
-            }
-            other => {
-                return Err((
-                    format!("{at}.kind"),
-                    format!("unknown kind `{other}` (spring_damper, bushing, mooring_line, fender)"),
-                ));
-            }
-        };
+        let kind = connection_kind(&out, c, &at, &a, &b)?;
         out.connections.push(Connection {
             name: c.name.clone(),
             a,
@@ -936,73 +805,7 @@ pub(crate) fn parse_external(
         let Some(body) = body_of(&t.body, &format!("{at}.body"), false)? else {
             return Err((format!("{at}.body"), "a tank sits on a body".into()));
         };
-        let direct = [t.a_tt, t.b_tt, t.c_tt, t.a_t4, t.c_t4].iter().any(Option::is_some);
-        let geometric = [
-            t.reservoir_spacing_m,
-            t.reservoir_width_m,
-            t.length_m,
-            t.duct_height_m,
-            t.fluid_height_m,
-            t.duct_below_roll_axis_m,
-            t.fluid_density_kg_m3,
-            t.damping_ratio,
-        ]
-        .iter()
-        .any(Option::is_some);
-        let tank = match (direct, geometric) {
-            (true, false) => {
-                let a_t4 = t.a_t4.unwrap_or(f64::NAN);
-                if !a_t4.is_finite() {
-                    return Err((format!("{at}.a_t4"), "is required (kg m^2, finite)".into()));
-                }
-                Tank {
-                    body,
-                    a_tt: positive(t.a_tt, &format!("{at}.a_tt"))?,
-                    b_tt: nonneg(t.b_tt, &format!("{at}.b_tt"))?,
-                    c_tt: positive(t.c_tt, &format!("{at}.c_tt"))?,
-                    a_t4,
-                    c_t4: positive(t.c_t4, &format!("{at}.c_t4"))?,
-                }
-            }
-            (false, true) => {
-                let r_d = t.duct_below_roll_axis_m.unwrap_or(f64::NAN);
-                if !r_d.is_finite() {
-                    return Err((
-                        format!("{at}.duct_below_roll_axis_m"),
-                        "is required (m, negative when the duct is above the roll axis)".into(),
-                    ));
-                }
-                let zeta = nonneg(t.damping_ratio, &format!("{at}.damping_ratio"))?;
-                TankGeometry {
-                    reservoir_spacing_m: positive(t.reservoir_spacing_m, &format!("{at}.reservoir_spacing_m"))?,
-                    reservoir_width_m: positive(t.reservoir_width_m, &format!("{at}.reservoir_width_m"))?,
-                    length_m: positive(t.length_m, &format!("{at}.length_m"))?,
-                    duct_height_m: positive(t.duct_height_m, &format!("{at}.duct_height_m"))?,
-                    fluid_height_m: positive(t.fluid_height_m, &format!("{at}.fluid_height_m"))?,
-                    duct_below_roll_axis_m: r_d,
-                    fluid_density_kg_m3: positive(
-                        t.fluid_density_kg_m3.or(Some(1025.0)),
-                        &format!("{at}.fluid_density_kg_m3"),
-                    )?,
-                    damping_ratio: zeta,
-                }
-                .coefficients(body, g_m_s2)
-            }
-            (true, true) => {
-                return Err((
-                    at.clone(),
-                    "give the coefficients (a_tt, b_tt, c_tt, a_t4, c_t4) or the geometry, not both".into(),
-                ));
-            }
-            (false, false) => {
-                return Err((
-                    at.clone(),
-                    "needs its coefficients (a_tt, b_tt, c_tt, a_t4, c_t4) or its geometry (reservoir_spacing_m, ...)"
-                        .into(),
-                ));
-            }
-        };
-        out.tanks.push(tank);
+        out.tanks.push(tank(t, &at, body, g_m_s2)?);
         out.tank_names.push(t.name.clone());
     }
     for (k, p) in points.iter().enumerate() {
@@ -1037,6 +840,233 @@ pub(crate) fn parse_external(
         });
     }
     Ok(out)
+}
+
+/// The body `name` (a key's value) names: its index, or None for `earth` where `earth` is allowed.
+fn body_of(body_names: &[String], name: &str, key: &str, earth: bool) -> Result<Option<usize>, KeyErr> {
+    if earth && name == "earth" {
+        return Ok(None);
+    }
+    body_names.iter().position(|b| b == name).map(Some).ok_or_else(|| {
+        (
+            key.into(),
+            format!(
+                "names no body: `{name}` (bodies: {}{})",
+                body_names.join(", "),
+                if earth { ", or \"earth\"" } else { "" }
+            ),
+        )
+    })
+}
+
+/// A new name: not empty, not among `names`.
+fn unique(names: &[&str], name: &str, key: &str) -> Result<(), KeyErr> {
+    if name.trim().is_empty() {
+        return Err((key.into(), "must not be empty".into()));
+    }
+    if names.contains(&name) {
+        return Err((key.into(), format!("`{name}` is used twice")));
+    }
+    Ok(())
+}
+
+/// Connection `at`'s model from its `kind` and the keys that kind takes (anchors `a`, `b`).
+fn connection_kind(
+    out: &External,
+    c: &ConnectionFile,
+    at: &str,
+    a: &Anchor,
+    b: &Anchor,
+) -> Result<ConnectionKind, KeyErr> {
+    let kind = match c.kind.as_str() {
+        "spring_damper" => {
+            only(c, at, &["axis", "stiffness_n_m", "damping_n_s_m", "pretension_n"])?;
+            let axis = c.axis.map(|v| unit(v, &format!("{at}.axis"))).transpose()?;
+            if axis.is_none() {
+                let d = out.rest_position(b) - out.rest_position(a);
+                if d.norm() < 1e-6 {
+                    return Err((
+                        format!("{at}.axis"),
+                        "the two points coincide: give the spring's axis".into(),
+                    ));
+                }
+            }
+            ConnectionKind::SpringDamper {
+                axis,
+                stiffness_n_m: nonneg(c.stiffness_n_m, &format!("{at}.stiffness_n_m"))?,
+                damping_n_s_m: nonneg(c.damping_n_s_m, &format!("{at}.damping_n_s_m"))?,
+                pretension_n: nonneg(c.pretension_n, &format!("{at}.pretension_n"))?,
+            }
+        }
+        "bushing" => bushing(c, at)?,
+        "mooring_line" => {
+            only(
+                c,
+                at,
+                &["curve", "tension_polynomial", "unstretched_length_m", "damping_n_s_m"],
+            )?;
+            let l0 = positive(c.unstretched_length_m, &format!("{at}.unstretched_length_m"))?;
+            ConnectionKind::MooringLine {
+                curve: curve(c, at, l0)?,
+                unstretched_length_m: l0,
+                damping_n_s_m: nonneg(c.damping_n_s_m, &format!("{at}.damping_n_s_m"))?,
+            }
+        }
+        "fender" => fender(c, at)?,
+        other => {
+            return Err((
+                format!("{at}.kind"),
+                format!("unknown kind `{other}` (spring_damper, bushing, mooring_line, fender)"),
+            ));
+        }
+    };
+    Ok(kind)
+}
+
+/// A line's or fender's force curve (`curve` table or `tension_polynomial`), valid over `range`.
+fn curve(c: &ConnectionFile, at: &str, range: f64) -> Result<Curve, KeyErr> {
+    let cv = match (&c.curve, &c.tension_polynomial) {
+        (Some(t), None) => Curve::Table(t.iter().map(|p| (p[0], p[1])).collect()),
+        (None, Some(p)) => Curve::Polynomial(p.clone()),
+        (Some(_), Some(_)) => {
+            return Err((
+                format!("{at}.curve"),
+                "give `curve` or `tension_polynomial`, not both".into(),
+            ));
+        }
+        (None, None) => return Err((format!("{at}.curve"), "is required".into())),
+    };
+    cv.validate(range).map_err(|m| (format!("{at}.curve"), m))?;
+    Ok(cv)
+}
+
+/// A bushing's six stiffnesses and dampings (each finite and >= 0; default 0).
+fn bushing(c: &ConnectionFile, at: &str) -> Result<ConnectionKind, KeyErr> {
+    only(c, at, &["stiffness", "damping"])?;
+    let six = |v: Option<[f64; 6]>, key: &str| -> Result<[f64; 6], KeyErr> {
+        let v = v.unwrap_or([0.0; 6]);
+        for (i, x) in v.iter().enumerate() {
+            if !(x.is_finite() && *x >= 0.0) {
+                return Err((
+                    format!("{at}.{key}[{i}]"),
+                    format!("must be finite and >= 0, found {x}"),
+                ));
+            }
+        }
+        Ok(v)
+    };
+    Ok(ConnectionKind::Bushing {
+        stiffness: six(c.stiffness, "stiffness")?,
+        damping: six(c.damping, "damping")?,
+    })
+}
+
+/// A fender: its curve, normal, initial compression and friction.
+fn fender(c: &ConnectionFile, at: &str) -> Result<ConnectionKind, KeyErr> {
+    only(
+        c,
+        at,
+        &[
+            "curve",
+            "normal",
+            "initial_compression_m",
+            "friction_coefficient",
+            "friction_velocity_m_s",
+        ],
+    )?;
+    if c.tension_polynomial.is_some() {
+        return Err((
+            format!("{at}.tension_polynomial"),
+            "fenders take a `curve` table".into(),
+        ));
+    }
+    let normal = match c.normal {
+        Some(v) => unit(v, &format!("{at}.normal"))?,
+        None => return Err((format!("{at}.normal"), "is required".into())),
+    };
+    let mu = nonneg(c.friction_coefficient, &format!("{at}.friction_coefficient"))?;
+    let vref = match c.friction_velocity_m_s {
+        None => 0.01,
+        v => positive(v, &format!("{at}.friction_velocity_m_s"))?,
+    };
+    Ok(ConnectionKind::Fender {
+        curve: curve(c, at, 1.0)?,
+        normal,
+        initial_compression_m: nonneg(c.initial_compression_m, &format!("{at}.initial_compression_m"))?,
+        friction_coefficient: mu,
+        friction_velocity_m_s: vref,
+    })
+}
+
+/// Tank `at` on `body`: from its coefficients or from its geometry (Lloyd's U-tube), not both.
+fn tank(t: &TankFile, at: &str, body: usize, g_m_s2: f64) -> Result<Tank, KeyErr> {
+    let direct = [t.a_tt, t.b_tt, t.c_tt, t.a_t4, t.c_t4].iter().any(Option::is_some);
+    let geometric = [
+        t.reservoir_spacing_m,
+        t.reservoir_width_m,
+        t.length_m,
+        t.duct_height_m,
+        t.fluid_height_m,
+        t.duct_below_roll_axis_m,
+        t.fluid_density_kg_m3,
+        t.damping_ratio,
+    ]
+    .iter()
+    .any(Option::is_some);
+    let tank = match (direct, geometric) {
+        (true, false) => {
+            let a_t4 = t.a_t4.unwrap_or(f64::NAN);
+            if !a_t4.is_finite() {
+                return Err((format!("{at}.a_t4"), "is required (kg m^2, finite)".into()));
+            }
+            Tank {
+                body,
+                a_tt: positive(t.a_tt, &format!("{at}.a_tt"))?,
+                b_tt: nonneg(t.b_tt, &format!("{at}.b_tt"))?,
+                c_tt: positive(t.c_tt, &format!("{at}.c_tt"))?,
+                a_t4,
+                c_t4: positive(t.c_t4, &format!("{at}.c_t4"))?,
+            }
+        }
+        (false, true) => {
+            let r_d = t.duct_below_roll_axis_m.unwrap_or(f64::NAN);
+            if !r_d.is_finite() {
+                return Err((
+                    format!("{at}.duct_below_roll_axis_m"),
+                    "is required (m, negative when the duct is above the roll axis)".into(),
+                ));
+            }
+            let zeta = nonneg(t.damping_ratio, &format!("{at}.damping_ratio"))?;
+            TankGeometry {
+                reservoir_spacing_m: positive(t.reservoir_spacing_m, &format!("{at}.reservoir_spacing_m"))?,
+                reservoir_width_m: positive(t.reservoir_width_m, &format!("{at}.reservoir_width_m"))?,
+                length_m: positive(t.length_m, &format!("{at}.length_m"))?,
+                duct_height_m: positive(t.duct_height_m, &format!("{at}.duct_height_m"))?,
+                fluid_height_m: positive(t.fluid_height_m, &format!("{at}.fluid_height_m"))?,
+                duct_below_roll_axis_m: r_d,
+                fluid_density_kg_m3: positive(
+                    t.fluid_density_kg_m3.or(Some(1025.0)),
+                    &format!("{at}.fluid_density_kg_m3"),
+                )?,
+                damping_ratio: zeta,
+            }
+            .coefficients(body, g_m_s2)
+        }
+        (true, true) => {
+            return Err((
+                at.to_string(),
+                "give the coefficients (a_tt, b_tt, c_tt, a_t4, c_t4) or the geometry, not both".into(),
+            ));
+        }
+        (false, false) => {
+            return Err((
+                at.to_string(),
+                "needs its coefficients (a_tt, b_tt, c_tt, a_t4, c_t4) or its geometry (reservoir_spacing_m, ...)"
+                    .into(),
+            ));
+        }
+    };
+    Ok(tank)
 }
 
 #[cfg(test)]

@@ -1,8 +1,9 @@
 //! The vessel system and its hydrodynamic database (pure: values in, values out, no IO).
 //!
 //! Owns: the WAMIT readers ([`wamit`]), the system file ([`system`]), the assembled database with its
-//! interpolation over frequency and heading ([`db`]), and radiation memory: impulse response functions,
-//! A_inf and the Kramers-Kronig check ([`radiation`]).
+//! interpolation over frequency and heading ([`db`]), and radiation: impulse response functions,
+//! A_inf and the Kramers-Kronig check ([`radiation`]), the radiation memory the time-domain models are
+//! built from ([`memory`]), the state-space fit ([`statespace`]) and `db check`'s checks ([`check`]).
 //!
 //! Conventions (DESIGN.md section 1, contracts):
 //! - SI units: m, s, kg, N, rad. Degrees only where a name says `_deg`.
@@ -17,8 +18,9 @@
 pub mod check;
 pub mod db;
 pub mod external;
-pub mod modal;
+pub mod memory;
 pub mod radiation;
+pub mod statespace;
 pub mod system;
 pub mod wamit;
 
@@ -39,16 +41,26 @@ pub enum Dof {
 impl Dof {
     pub const ALL: [Dof; 6] = [Dof::Surge, Dof::Sway, Dof::Heave, Dof::Roll, Dof::Pitch, Dof::Yaw];
 
+    /// The one table of DOF names, in [`Dof::ALL`]'s order: the name in system files, channels and
+    /// labels, and the output column's name with the unit its values are written in.
+    const TABLE: [(&'static str, &'static str); 6] = [
+        ("surge", "surge_m"),
+        ("sway", "sway_m"),
+        ("heave", "heave_m"),
+        ("roll", "roll_deg"),
+        ("pitch", "pitch_deg"),
+        ("yaw", "yaw_deg"),
+    ];
+
+    /// The names of [`Dof::ALL`]: `surge` .. `yaw`.
+    pub const NAMES: [&'static str; 6] = {
+        let t = Dof::TABLE;
+        [t[0].0, t[1].0, t[2].0, t[3].0, t[4].0, t[5].0]
+    };
+
     /// Lower-case name as used in system files and outputs.
     pub fn name(self) -> &'static str {
-        match self {
-            Dof::Surge => "surge",
-            Dof::Sway => "sway",
-            Dof::Heave => "heave",
-            Dof::Roll => "roll",
-            Dof::Pitch => "pitch",
-            Dof::Yaw => "yaw",
-        }
+        Dof::TABLE[self.index()].0
     }
 
     pub fn from_name(name: &str) -> Option<Dof> {
@@ -63,14 +75,7 @@ impl Dof {
     /// Name with the unit its values are written in by CSV and JSON outputs (`surge_m` .. `yaw_deg`):
     /// the edges speak degrees (DESIGN.md section 1), the core radians.
     pub fn output_name(self) -> &'static str {
-        match self {
-            Dof::Surge => "surge_m",
-            Dof::Sway => "sway_m",
-            Dof::Heave => "heave_m",
-            Dof::Roll => "roll_deg",
-            Dof::Pitch => "pitch_deg",
-            Dof::Yaw => "yaw_deg",
-        }
+        Dof::TABLE[self.index()].1
     }
 
     /// A value in the core's unit (m or rad) in the unit of [`Dof::output_name`] (m or deg).
@@ -86,6 +91,36 @@ impl Dof {
     /// The DOF of a 0-based global index (6k + j).
     pub fn of_index(global: usize) -> Dof {
         Dof::ALL[global % 6]
+    }
+}
+
+/// `carrier.heave` style label of a 0-based global mode index.
+pub fn mode_label(sys: &VesselSystem, i: usize) -> String {
+    if i >= sys.n_modes() {
+        let k = i - sys.n_modes();
+        let name = sys.spec.external.tank_names.get(k).map(|s| s.as_str()).unwrap_or("?");
+        return format!("{name}.tank_angle");
+    }
+    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
+    format!("{body}.{}", Dof::of_index(i).name())
+}
+
+/// The output column of state `i` with its unit (`carrier.heave_m`, `carrier.roll_deg`,
+/// `<tank>.tank_angle_deg`), as CSV and JSON outputs write it; [`output_value`] converts the value.
+pub fn output_label(sys: &VesselSystem, i: usize) -> String {
+    if i >= sys.n_modes() {
+        return format!("{}_deg", mode_label(sys, i));
+    }
+    let body = sys.spec.bodies.get(i / 6).map(|b| b.name.as_str()).unwrap_or("?");
+    format!("{body}.{}", Dof::of_index(i).output_name())
+}
+
+/// State `i`'s value (m or rad) in the unit of its [`output_label`] (m or deg; a tank angle in deg).
+pub fn output_value(sys: &VesselSystem, i: usize, si: f64) -> f64 {
+    if i >= sys.n_modes() {
+        si.to_degrees()
+    } else {
+        Dof::of_index(i).to_output(si)
     }
 }
 

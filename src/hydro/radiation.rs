@@ -512,7 +512,7 @@ pub fn fit_tail(
     // the far part never lifts the tail above the data's last damping: B_N r^3 + D r^2 (1 - r) <= B_N
     // for r = w_N/w in (0, 1] needs D_ii <= TAIL_FAR_CAP B_N,ii; enforced by the congruence S D S (S
     // diagonal, so D stays PSD). Without it a database whose A_inf is off by a constant (WEC-Sim's RM3)
-    // had the fit invent a damping bump 10^7 times its last value
+    // makes the fit invent a damping bump orders of magnitude above its last value
     let cap: Vec<f64> = (0..n)
         .map(|i| {
             let (d, b) = (far[(i, i)], TAIL_FAR_CAP * cubic.b_n[(i, i)].max(0.0));

@@ -18,7 +18,8 @@
 //!   constant; or given on the command line). A probe sees a long-crested sea: every `period_s` a
 //!   field is fitted to the last `window_s` of the record ([`crate::waves::observe::from_probe`]).
 
-use super::{MotionRecord, WavesRecord};
+use crate::hydro::Dof;
+use crate::record::{MotionRecord, WavesRecord};
 use crate::waves::field::heading_from_compass_deg;
 use crate::waves::observe::from_probe;
 
@@ -108,31 +109,24 @@ impl Table {
     }
 }
 
-const X_COLS: [&str; 6] = ["surge_m", "sway_m", "heave_m", "roll_deg", "pitch_deg", "yaw_deg"];
-const V_COLS: [&str; 6] = [
-    "surge_m_s",
-    "sway_m_s",
-    "heave_m_s",
-    "roll_deg_s",
-    "pitch_deg_s",
-    "yaw_deg_s",
-];
-
 /// Motion samples from a CSV text (`file` names it in errors), vessels named as in `vessels`; sorted
 /// by time per vessel, SI units (m, rad).
 pub fn motion_csv(text: &str, file: &str, vessels: &[String]) -> Result<Vec<MotionRecord>, String> {
     let t = table(text, file)?;
     let ct = t.need("time_s", file)?;
     let cv = t.need("vessel", file)?;
-    let cx: Vec<usize> = X_COLS.iter().map(|c| t.need(c, file)).collect::<Result<_, _>>()?;
-    let given: Vec<Option<usize>> = V_COLS.iter().map(|c| t.col(c)).collect();
+    // the columns: each DOF's output name (`surge_m` .. `yaw_deg`) and its rate (`surge_m_s` .. `yaw_deg_s`)
+    let x_cols = Dof::ALL.map(Dof::output_name);
+    let v_cols = Dof::ALL.map(|d| format!("{}_s", d.output_name()));
+    let cx: Vec<usize> = x_cols.iter().map(|c| t.need(c, file)).collect::<Result<_, _>>()?;
+    let given: Vec<Option<usize>> = v_cols.iter().map(|c| t.col(c)).collect();
     let cvel: Option<Vec<usize>> = match given.iter().filter(|c| c.is_some()).count() {
         0 => None,
         6 => Some(given.into_iter().flatten().collect()),
         _ => {
             return Err(format!(
                 "{file}: give all six velocity columns ({}) or none",
-                V_COLS.join(", ")
+                v_cols.join(", ")
             ));
         }
     };

@@ -12,11 +12,11 @@ use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
 /// The longest forecast, s: the daemon's `forecast.horizon_s`, a scenario's `horizon_s` and the CLI's
-/// `--horizon` are all bounded by it. No radar-observed sea is predictable for more than minutes; the
+/// `--horizon` (alias `--length`) are all bounded by it. No radar-observed sea is predictable for more than minutes; the
 /// bound keeps the forecast's buffers (steps x states) sized by input within reason.
 pub const MAX_FORECAST_LENGTH_S: f64 = 3600.0;
 
-/// Most steps of one forecast (horizon / dt): an hour at 0.01 s; the forecast of a 24-state system
+/// Most steps of one forecast (length / dt): an hour at 0.01 s; the forecast of a 24-state system
 /// that long is 70 MB.
 pub const MAX_FORECAST_STEPS: usize = 360_000;
 
@@ -31,7 +31,8 @@ pub struct ForecastRequest<'a> {
     pub memory: &'a Memory,
     /// Wave components in the seakeeping frame, amplitudes at the origin at t0.
     pub waves: &'a [WaveComponent],
-    /// Forecast length, s.
+    /// Forecast length, s (the field keeps the daemon's `forecast.horizon_s` name: it is not the
+    /// predictable horizon).
     pub horizon_s: f64,
     /// Optional ramp of the wave force over its first seconds (regular-wave runs), s; 0 = none.
     pub ramp_s: f64,
@@ -174,17 +175,16 @@ impl Forecaster {
     pub fn forecast(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<&Forecast> {
         let n = model.n();
         let dt = model.opts.dt_s;
-        if !(req.horizon_s.is_finite() && req.horizon_s > 0.0 && req.horizon_s <= MAX_FORECAST_LENGTH_S) {
+        let length_s = req.horizon_s;
+        if !(length_s.is_finite() && length_s > 0.0 && length_s <= MAX_FORECAST_LENGTH_S) {
             return Err(Error::Input(format!(
-                "forecast length {} s: must be in (0, {MAX_FORECAST_LENGTH_S}] s",
-                req.horizon_s
+                "forecast length {length_s} s: must be in (0, {MAX_FORECAST_LENGTH_S}] s"
             )));
         }
-        let steps = (req.horizon_s / dt).round() as usize;
+        let steps = (length_s / dt).round() as usize;
         if steps > MAX_FORECAST_STEPS {
             return Err(Error::Input(format!(
-                "forecast length {} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}",
-                req.horizon_s
+                "forecast length {length_s} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}"
             )));
         }
         self.wave_force(model, req.waves, steps, req.ramp_s)?;
@@ -236,7 +236,7 @@ impl Forecaster {
         &mut self,
         model: &TimeModel,
         waves: &[WaveComponent],
-        horizon_s: f64,
+        length_s: f64,
         ramp_s: f64,
     ) -> Result<&Forecast> {
         let z = vec![0.0; model.n()];
@@ -246,7 +246,7 @@ impl Forecaster {
             v0: &z,
             memory: &memory,
             waves,
-            horizon_s,
+            horizon_s: length_s,
             ramp_s,
         };
         self.forecast(model, &req)

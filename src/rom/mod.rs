@@ -23,7 +23,7 @@
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
 //! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs,
-//! [`partitioned`]) or the modal state-space model ([`crate::hydro::modal`]: vector fit, balanced
+//! [`partitioned`]) or the modal state-space model ([`crate::hydro::statespace`]: vector fit, balanced
 //! truncation, passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).

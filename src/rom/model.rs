@@ -3,11 +3,11 @@
 use super::modal::ModalStep;
 use super::partitioned::{Partitions, block_for};
 use super::{Error, Result};
-use crate::hydro::check::{
+use crate::hydro::memory::{
     RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
 };
-use crate::hydro::modal::{ModalModel, ModalOptions};
 use crate::hydro::radiation;
+use crate::hydro::statespace::{ModalModel, ModalOptions};
 use crate::hydro::{HydroDb, VesselSystem};
 use nalgebra::DMatrix;
 
@@ -178,6 +178,89 @@ pub struct TimeModel {
     irf: Option<radiation::Irf>,
 }
 
+/// The convolution's kernel: K's taps at the solver's step `dt` weighted by the trapezoidal rule, over
+/// the `n` active states (`hyd` reads a hydrodynamic matrix there, zero on tank states), and the
+/// instantaneous part (tap 0).
+fn convolution_kernel(
+    irf_all: &radiation::Irf,
+    hyd: &dyn Fn(&DMatrix<f64>, usize, usize) -> f64,
+    n: usize,
+    dt: f64,
+) -> (Kernel, DMatrix<f64>) {
+    let taps = irf_all.k.len();
+    let mut k = vec![0.0; n * taps * n];
+    for (m, km) in irf_all.k.iter().enumerate() {
+        let w = if m == 0 || m + 1 == taps { 0.5 } else { 1.0 };
+        for i in 0..n {
+            for j in 0..n {
+                k[(i * taps + m) * n + j] = dt * w * hyd(km, i, j);
+            }
+        }
+    }
+    let d = DMatrix::from_fn(n, n, |i, j| k[(i * taps) * n + j]);
+    let parts = std::sync::Arc::new(Partitions::new(&k, taps, n, block_for(taps)));
+    (Kernel::Convolution { taps, k, parts }, d)
+}
+
+/// K over the `n` active states (unweighted) on the solver's step `dt`.
+fn active_irf(
+    irf_all: &radiation::Irf,
+    hyd: &dyn Fn(&DMatrix<f64>, usize, usize) -> f64,
+    n: usize,
+    dt: f64,
+) -> radiation::Irf {
+    radiation::Irf {
+        dt_s: dt,
+        k: irf_all
+            .k
+            .iter()
+            .map(|km| DMatrix::from_fn(n, n, |r, c| hyd(km, r, c)))
+            .collect(),
+    }
+}
+
+/// The state-space kernel: the passive fit of the active DOFs' radiation (A_inf `a_inf_all`, damping
+/// tail `tail`) with its exact step, and its instantaneous part; the fit's passivity cover is added to
+/// `damping`.
+fn state_space_kernel(
+    sys: &VesselSystem,
+    a_inf_all: &DMatrix<f64>,
+    tail: &radiation::DampingTail,
+    opts: &RomOptions,
+    n: usize,
+    damping: &mut DMatrix<f64>,
+) -> Result<(Kernel, DMatrix<f64>)> {
+    let nh = sys.active_indices().len();
+    let dt = opts.dt_s;
+    let model = active_radiation(sys, a_inf_all, tail)
+        .fit(
+            &sys.db.omega_rad_s,
+            ModalOptions {
+                tolerance: opts.ss_tolerance,
+                ..ModalOptions::default()
+            },
+        )
+        .map_err(|e| Error::Input(format!("state-space radiation: {}", e.0)))?;
+    let step = ModalStep::new(&model, dt);
+    let di = step.instantaneous();
+    let mut d = DMatrix::zeros(n, n);
+    d.view_mut((0, 0), (nh, nh)).copy_from(&di);
+    // passivity cover: constant damping where the fit's Re K dips below zero (see hydro::statespace)
+    for i in 0..nh {
+        damping[(i, i)] += model.cover * model.scale[i];
+    }
+    // A_inf as the convolution's (Ogilvie's from the IRF unless the system file asks for the
+    // database's): the fit reproduces the same damping and tail, so the same K; an Ogilvie
+    // estimate from the fitted kernel would carry the fit's error into the added mass
+    Ok((
+        Kernel::StateSpace {
+            model: Box::new(model),
+            step: Box::new(step),
+        },
+        d,
+    ))
+}
+
 impl TimeModel {
     pub fn new(sys: &VesselSystem, opts: RomOptions) -> Result<TimeModel> {
         opts.validate()?;
@@ -199,8 +282,7 @@ impl TimeModel {
         // the IRF from passive damping and the damping tail, fitted where it is sampled: the convolution
         // samples K at the solver's step; the state-space model is fitted once per database (and speed)
         // on the system file's IRF grid (`irf.dt_s`), so it, its tail and its A_inf do not move with the
-        // solver's step (measured on the pair: refitted at each step, its floor was 1.9 % of peak off
-        // the frequency domain at dt = 0.05 s and 3.3 % at 0.025 s, lighter yaw in beam seas at 0.05 rad/s)
+        // solver's step (a fit at each step would move the model's floor with dt)
         let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
         // the grids K is sampled on: the solver's (convolution) and the system file's (state-space fit)
         let grid_dt = match opts.radiation {
@@ -215,9 +297,8 @@ impl TimeModel {
             RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
             _ => radiation_memory(sys, dt, memory_s),
         };
-        // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's;
-        // measured on the one-ship demo, the database's A_inf put the time-domain heave RAO 1.1 % of
-        // peak off the frequency domain at any dt, Ogilvie's 0.15 % at dt = 0.05 s
+        // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's
+        // (Ogilvie's is consistent with the K the model runs, so its floor is the closer one)
         let a_inf_all = model_a_inf(sys, &irf_all);
         let terms = sys.linear_terms();
         let pad = |m: &DMatrix<f64>| sys.pad_states(m);
@@ -241,68 +322,15 @@ impl TimeModel {
                     DMatrix::zeros(n, n),
                 )
             }
-            RadiationMethod::Convolution => {
-                let taps = irf_all.k.len();
-                let mut k = vec![0.0; n * taps * n];
-                for (m, km) in irf_all.k.iter().enumerate() {
-                    let w = if m == 0 || m + 1 == taps { 0.5 } else { 1.0 };
-                    for i in 0..n {
-                        for j in 0..n {
-                            k[(i * taps + m) * n + j] = dt * w * hyd(km, i, j);
-                        }
-                    }
-                }
-                let d = DMatrix::from_fn(n, n, |i, j| k[(i * taps) * n + j]);
-                let parts = std::sync::Arc::new(Partitions::new(&k, taps, n, block_for(taps)));
-                (Kernel::Convolution { taps, k, parts }, d)
-            }
-            RadiationMethod::StateSpace => {
-                let model = active_radiation(sys, &a_inf_all, &tail)
-                    .fit(
-                        &sys.db.omega_rad_s,
-                        ModalOptions {
-                            tolerance: opts.ss_tolerance,
-                            ..ModalOptions::default()
-                        },
-                    )
-                    .map_err(|e| Error::Input(format!("state-space radiation: {}", e.0)))?;
-                let step = ModalStep::new(&model, dt);
-                let di = step.instantaneous();
-                let mut d = DMatrix::zeros(n, n);
-                d.view_mut((0, 0), (nh, nh)).copy_from(&di);
-                // passivity cover: constant damping where the fit's Re K dips below zero (see modal)
-                for i in 0..nh {
-                    damping[(i, i)] += model.cover * model.scale[i];
-                }
-                // A_inf as the convolution's (Ogilvie's from the IRF unless the system file asks for the
-                // database's): the fit reproduces the same damping and tail, so the same K. Measured: the
-                // Ogilvie estimate from the fitted kernel instead put the pair's lighter yaw 3.6 % of
-                // peak off the frequency domain at heading 150 (1.8 % this way), the ship 0.38 % (0.33 %)
-                (
-                    Kernel::StateSpace {
-                        model: Box::new(model),
-                        step: Box::new(step),
-                    },
-                    d,
-                )
-            }
+            RadiationMethod::Convolution => convolution_kernel(&irf_all, &hyd, n, dt),
+            RadiationMethod::StateSpace => state_space_kernel(sys, &a_inf_all, &tail, &opts, n, &mut damping)?,
         };
         let s = &mass + (&damping + &d_inst) * (dt / 2.0) + &stiffness * (opts.beta * dt * dt);
         let s_inv = s
             .try_inverse()
             .ok_or_else(|| Error::Input("the implicit step matrix is singular (no mass on an active DOF?)".into()))?;
-        let irf = match opts.radiation {
-            RadiationMethod::Constant { .. } => None,
-            RadiationMethod::Convolution => Some(radiation::Irf {
-                dt_s: dt,
-                k: irf_all
-                    .k
-                    .iter()
-                    .map(|km| DMatrix::from_fn(n, n, |r, c| hyd(km, r, c)))
-                    .collect(),
-            }),
-            RadiationMethod::StateSpace => None,
-        };
+        // the convolution's IRF for the implied frequency response (active DOFs, unweighted)
+        let irf = matches!(opts.radiation, RadiationMethod::Convolution).then(|| active_irf(&irf_all, &hyd, n, dt));
         let mass_inv = mass
             .clone()
             .try_inverse()
@@ -320,10 +348,7 @@ impl TimeModel {
             let z = vec![0.0; sys.n_states()];
             e.nonlinear_force(&z, &z, &mut nl_offset);
         }
-        let labels = active
-            .iter()
-            .map(|&i| crate::hydro::check::mode_label(sys, i))
-            .collect();
+        let labels = active.iter().map(|&i| crate::hydro::mode_label(sys, i)).collect();
         let mut bdc = DMatrix::zeros(n, 2 * n);
         bdc.view_mut((0, 0), (n, n)).copy_from(&(&damping + &d_inst));
         bdc.view_mut((0, n), (n, n)).copy_from(&stiffness);

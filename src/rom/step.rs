@@ -33,7 +33,7 @@ impl StepChoice {
             Some((i, t)) => format!(
                 "{} s: {STEPS_PER_PERIOD:.0} steps in the shortest natural period ({} {t:.2} s), in whole {} s",
                 self.dt_s,
-                crate::hydro::check::mode_label(sys, i),
+                crate::hydro::mode_label(sys, i),
                 1.0 / DT_QUANTA_PER_S
             ),
             None => format!(

@@ -210,22 +210,7 @@ impl Stepper {
             return Err(Error::Input("stepper capacity exceeded".into()));
         }
         // radiation: known part P
-        match &model.kernel {
-            Kernel::Convolution { taps, k, parts } => {
-                // taps 1..B-1 over v_k1-1 back to v_1 directly; the partitions have the rest
-                let mcount = (k1 - 1).min(parts.block - 1).min(taps - 1);
-                let start = self.pos(k1 as isize - 1);
-                let tail = self.run.tail(parts, k1);
-                for i in 0..n {
-                    let row = &k[(i * taps + 1) * n..(i * taps + 1 + mcount) * n];
-                    let known_i = known.get(i).copied().unwrap_or(0.0);
-                    self.p[i] = known_i + tail[i] + dot(row, &self.buf[start..start + mcount * n]);
-                }
-            }
-            // the states hold everything but the new input (E xi + g0 beta_k): their force, computed
-            // when they were
-            Kernel::StateSpace { .. } => self.p.copy_from_slice(&self.rad_next),
-        }
+        self.known_radiation(model, k1, known);
         // predictor (the short loops over the DOFs take slices of length n first: no bounds checks, no
         // reloads of the vectors through `self`, and they vectorize)
         {
@@ -308,6 +293,35 @@ impl Stepper {
         if bounded {
             return Ok(());
         }
+        self.divergence(model, k1)
+    }
+
+    /// The known part P of the radiation force at step `k1`: the convolution's taps 1..B-1 over the
+    /// run's velocities directly and the partitions' rest, or the modal states' force.
+    #[inline(always)]
+    fn known_radiation(&mut self, model: &TimeModel, k1: usize, known: &[f64]) {
+        let n = self.n;
+        match &model.kernel {
+            Kernel::Convolution { taps, k, parts } => {
+                // taps 1..B-1 over v_k1-1 back to v_1 directly; the partitions have the rest
+                let mcount = (k1 - 1).min(parts.block - 1).min(taps - 1);
+                let start = self.pos(k1 as isize - 1);
+                let tail = self.run.tail(parts, k1);
+                for i in 0..n {
+                    let row = &k[(i * taps + 1) * n..(i * taps + 1 + mcount) * n];
+                    let known_i = known.get(i).copied().unwrap_or(0.0);
+                    self.p[i] = known_i + tail[i] + dot(row, &self.buf[start..start + mcount * n]);
+                }
+            }
+            // the states hold everything but the new input (E xi + g0 beta_k): their force, computed
+            // when they were
+            Kernel::StateSpace { .. } => self.p.copy_from_slice(&self.rad_next),
+        }
+    }
+
+    /// The error of a step `k1` that left the bounds: the first DOF non-finite or beyond 1e4 m or rad.
+    fn divergence(&self, model: &TimeModel, k1: usize) -> Result<()> {
+        let (n, dt) = (self.n, model.opts.dt_s);
         for i in 0..n {
             let (x, v) = (self.x[i], self.v[i]);
             if !(x.is_finite() && v.is_finite()) {

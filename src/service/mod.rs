@@ -82,7 +82,7 @@ pub fn history_wanted_s(cfg: &ShipcastConfig, sys: &VesselSystem) -> f64 {
     match (cfg.forecast.memory_s, cfg.forecast.radiation.as_str()) {
         (Some(m), _) => m,
         (None, "state-space") => STATE_SPACE_HISTORY_S,
-        (None, _) => crate::hydro::check::memory_duration_s(sys),
+        (None, _) => crate::hydro::memory::memory_duration_s(sys),
     }
 }
 
@@ -857,11 +857,11 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
         None
     } else {
         let dir = cfg.dir.join(&cfg.record.dir);
-        match crate::replay::RotatingRecorder::new(
+        match crate::record::RotatingRecorder::new(
             &dir,
             cfg.record.rotate_mb,
             cfg.record.rotate_s,
-            crate::replay::LogInfo::of(&cfg, &sys, "daemon"),
+            crate::record::LogInfo::of(&cfg, &cfg.system.file, &sys, "daemon"),
         ) {
             Ok(r) => Some(r),
             Err(e) => {
@@ -870,7 +870,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
             }
         }
     };
-    fn record(recorder: &mut Option<crate::replay::RotatingRecorder>, t: f64, r: crate::replay::Record) {
+    fn record(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, r: crate::record::Record) {
         if let Some(rec) = recorder.as_mut()
             && let Err(e) = rec.record(t, &r)
         {
@@ -888,7 +888,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                 let Some(msg) = msg else { break };
                 let t = clock();
                 if recorder.is_some() {
-                    use crate::replay::{MotionRecord, Record, WavesRecord};
+                    use crate::record::{MotionRecord, Record, WavesRecord};
                     match &msg {
                         Input::Motion(m) => record(&mut recorder, t, Record::Motion(MotionRecord {
                             vessel: m.vessel, time_s: m.time_s, x: m.x, v: m.v,
@@ -907,7 +907,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                 };
                 if let Some(out) = engine.done(d) {
                     if let Output::Forecast(h, v) = &out {
-                        let rec = crate::replay::Record::Forecast(crate::replay::ForecastRecord::of(h, v));
+                        let rec = crate::record::Record::Forecast(crate::record::ForecastRecord::of(h, v));
                         record(&mut recorder, clock(), rec);
                     }
                     let _ = out_tx.send(out);
@@ -923,7 +923,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
                 let t = clock();
-                record(&mut recorder, t, crate::replay::Record::Tick(crate::replay::TickRecord { clock_s: t }));
+                record(&mut recorder, t, crate::record::Record::Tick(crate::record::TickRecord { clock_s: t }));
                 if let Some(job) = engine.tick(t) {
                     let _ = job_tx.send(job);
                 }

@@ -56,7 +56,7 @@ pub struct WaveField {
 }
 
 /// A field's header numbers in the flat layout shared by the wire (`ipc::wire::WaveHeader`) and the
-/// log (`replay::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
+/// log (`record::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
 /// Radius 0 = no region known (read back as [`Region::Everywhere`]); a negative radius = a wave probe
 /// at the reference point ([`Region::Point`]; a probe's field is referred to its point); depth 0 =
 /// infinite.

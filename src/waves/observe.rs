@@ -81,32 +81,7 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
     let (nx, ny) = (first.x_m.len(), first.y_m.len());
     let dx = uniform_spacing(&first.x_m, "x_m", 0)?;
     let dy = uniform_spacing(&first.y_m, "y_m", 0)?;
-    for (s, g) in grids.iter().enumerate() {
-        if g.x_m != first.x_m || g.y_m != first.y_m {
-            return Err(Error::Invalid(format!(
-                "snapshot {s}: a different grid from snapshot 0"
-            )));
-        }
-        if g.values.len() != nx * ny {
-            return Err(Error::Invalid(format!(
-                "snapshot {s}: {} values for a {nx} x {ny} grid",
-                g.values.len()
-            )));
-        }
-        if let Some(i) = g.values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "snapshot {s}: cell (ix {}, iy {}) is not finite ({})",
-                i % nx,
-                i / nx,
-                g.values[i]
-            )));
-        }
-        if !g.time_s.is_finite() || (s > 0 && g.time_s <= grids[s - 1].time_s) {
-            return Err(Error::Invalid(format!(
-                "snapshot {s}: times must be finite and increasing"
-            )));
-        }
-    }
+    check_snapshots(grids, nx, ny)?;
     if grids.len() == 1 && opts.mean_direction_rad.is_none() {
         return Err(Error::Invalid(
             "a single snapshot cannot tell opposite directions apart: give the mean direction or a sequence".into(),
@@ -114,31 +89,7 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
     }
     let t_ref = grids[grids.len() - 1].time_s;
     let n = (nx * ny) as f64;
-    // 2-D FFT of each snapshot (rows, then columns)
-    let mut planner = FftPlanner::new();
-    let fx = planner.plan_fft_forward(nx);
-    let fy = planner.plan_fft_forward(ny);
-    let spectra: Vec<Vec<Complex64>> = grids
-        .iter()
-        .map(|g| {
-            let mean = g.values.iter().sum::<f64>() / n;
-            let mut c: Vec<Complex64> = g.values.iter().map(|v| Complex64::new(v - mean, 0.0)).collect();
-            for row in c.chunks_exact_mut(nx) {
-                fx.process(row);
-            }
-            let mut col = vec![Complex64::default(); ny];
-            for ix in 0..nx {
-                for iy in 0..ny {
-                    col[iy] = c[iy * nx + ix];
-                }
-                fy.process(&mut col);
-                for iy in 0..ny {
-                    c[iy * nx + ix] = col[iy];
-                }
-            }
-            c
-        })
-        .collect();
+    let spectra = spectra_2d(grids, nx, ny);
     let (lx, ly) = (dx * nx as f64, dy * ny as f64);
     let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
     let centre = [
@@ -165,34 +116,8 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
                 continue;
             }
             let c: Vec<Complex64> = spectra.iter().map(|s| s[iy * nx + ix]).collect();
-            let (p, q) = if grids.len() == 1 {
-                let d = opts.mean_direction_rad.unwrap_or(0.0);
-                if kx * d.cos() + ky * d.sin() >= 0.0 {
-                    (Complex64::default(), c[0])
-                } else {
-                    (c[0], Complex64::default())
-                }
-            } else {
-                // least squares: c_j = P e_j + Q conj(e_j), e_j = exp(i w (t_j - t_ref))
-                let e: Vec<Complex64> = grids
-                    .iter()
-                    .map(|g| Complex64::from_polar(1.0, w * (g.time_s - t_ref)))
-                    .collect();
-                let (mut a11, mut a12) = (0.0, Complex64::default());
-                let (mut b1, mut b2) = (Complex64::default(), Complex64::default());
-                for (ej, cj) in e.iter().zip(&c) {
-                    a11 += 1.0;
-                    a12 += ej.conj() * ej.conj();
-                    b1 += ej.conj() * cj;
-                    b2 += ej * cj;
-                }
-                // [[a11, a12], [conj(a12), a11]] [P, Q] = [b1, b2]
-                let det = a11 * a11 - a12.norm_sqr();
-                if det <= 1e-9 * a11 * a11 {
-                    // the snapshots sample this frequency at the same phase: no separation possible
-                    continue;
-                }
-                ((b1 * a11 - a12 * b2) / det, (b2 * a11 - a12.conj() * b1) / det)
+            let Some((p, q)) = separate(grids, &c, w, t_ref, opts.mean_direction_rad, [kx, ky]) else {
+                continue;
             };
             // amplitudes at the grid origin, then at the centre
             for (coef, sign, conj) in [(p, -1.0, false), (q, 1.0, true)] {
@@ -227,6 +152,110 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
     };
     f.validate()?;
     Ok(f)
+}
+
+/// Every snapshot on the first one's grid, with `nx` x `ny` finite values, at finite increasing times.
+fn check_snapshots(grids: &[Grid], nx: usize, ny: usize) -> Result<()> {
+    let first = &grids[0];
+    for (s, g) in grids.iter().enumerate() {
+        if g.x_m != first.x_m || g.y_m != first.y_m {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: a different grid from snapshot 0"
+            )));
+        }
+        if g.values.len() != nx * ny {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: {} values for a {nx} x {ny} grid",
+                g.values.len()
+            )));
+        }
+        if let Some(i) = g.values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: cell (ix {}, iy {}) is not finite ({})",
+                i % nx,
+                i / nx,
+                g.values[i]
+            )));
+        }
+        if !g.time_s.is_finite() || (s > 0 && g.time_s <= grids[s - 1].time_s) {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: times must be finite and increasing"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The 2-D FFT of each snapshot less its mean (rows, then columns).
+fn spectra_2d(grids: &[Grid], nx: usize, ny: usize) -> Vec<Vec<Complex64>> {
+    let n = (nx * ny) as f64;
+    let mut planner = FftPlanner::new();
+    let fx = planner.plan_fft_forward(nx);
+    let fy = planner.plan_fft_forward(ny);
+    grids
+        .iter()
+        .map(|g| {
+            let mean = g.values.iter().sum::<f64>() / n;
+            let mut c: Vec<Complex64> = g.values.iter().map(|v| Complex64::new(v - mean, 0.0)).collect();
+            for row in c.chunks_exact_mut(nx) {
+                fx.process(row);
+            }
+            let mut col = vec![Complex64::default(); ny];
+            for ix in 0..nx {
+                for iy in 0..ny {
+                    col[iy] = c[iy * nx + ix];
+                }
+                fy.process(&mut col);
+                for iy in 0..ny {
+                    c[iy * nx + ix] = col[iy];
+                }
+            }
+            c
+        })
+        .collect()
+}
+
+/// The spectra `c` (one per snapshot) of wavenumber `k_rad_m` split into the waves travelling along it
+/// and against it (P, Q) at frequency `w`, referred to `t_ref`: by the mean direction for one snapshot,
+/// by least squares for a sequence; None when the snapshots cannot tell them apart.
+fn separate(
+    grids: &[Grid],
+    c: &[Complex64],
+    w: f64,
+    t_ref: f64,
+    mean_direction_rad: Option<f64>,
+    k_rad_m: [f64; 2],
+) -> Option<(Complex64, Complex64)> {
+    let [kx, ky] = k_rad_m;
+    if grids.len() == 1 {
+        let d = mean_direction_rad.unwrap_or(0.0);
+        if kx * d.cos() + ky * d.sin() >= 0.0 {
+            Some((Complex64::default(), c[0]))
+        } else {
+            Some((c[0], Complex64::default()))
+        }
+    } else {
+        // least squares: c_j = P e_j + Q conj(e_j), e_j = exp(i w (t_j - t_ref))
+        let e: Vec<Complex64> = grids
+            .iter()
+            .map(|g| Complex64::from_polar(1.0, w * (g.time_s - t_ref)))
+            .collect();
+        let (mut a11, mut a12) = (0.0, Complex64::default());
+        let (mut b1, mut b2) = (Complex64::default(), Complex64::default());
+        for (ej, cj) in e.iter().zip(c) {
+            a11 += 1.0;
+            a12 += ej.conj() * ej.conj();
+            b1 += ej.conj() * cj;
+            b2 += ej * cj;
+        }
+        // [[a11, a12], [conj(a12), a11]] [P, Q] = [b1, b2]
+        let det = a11 * a11 - a12.norm_sqr();
+        if det <= 1e-9 * a11 * a11 {
+            // the snapshots sample this frequency at the same phase: no separation possible
+            return None;
+        }
+        Some(((b1 * a11 - a12 * b2) / det, (b2 * a11 - a12.conj() * b1) / det))
+    }
 }
 
 /// A wave-probe record: `eta_m` sampled every `dt_s` up to `end_time_s` (the last sample), at

@@ -187,6 +187,74 @@ pub fn fit_errors(
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitError(pub String);
 
+/// The fit's rows: the data (damping and added mass), then B(0) = 0 and the IRF's damping tail beyond
+/// the data (damping only: the added mass there is unknown), so the fit stays passive where the data
+/// end. Returns the frequencies and, per row, (frequency index, false).
+fn fit_rows(omegas: &[f64]) -> (Vec<f64>, Vec<(usize, bool)>) {
+    let nw = omegas.len();
+    let wn = omegas[nw - 1];
+    let mut freqs: Vec<f64> = omegas.to_vec();
+    let mut rows: Vec<(usize, bool)> = (0..nw).map(|k| (k, false)).collect();
+    // B(0) = 0 and, below the data, B linear to 0 as the convolution's IRF integrates it (the low
+    // frequencies set the zero-frequency added mass, hence the drift of modes without restoring)
+    freqs.push(0.0);
+    rows.push((nw, false));
+    for k in 1..LOW_ROWS {
+        rows.push((freqs.len(), false));
+        freqs.push(omegas[0] * k as f64 / LOW_ROWS as f64);
+    }
+    // tail nodes as dense as the data at the band's edge, spreading out by TAIL_SPREAD per node (a
+    // sparse tail lets a spurious lightly damped pole sit just above the band)
+    let mut step = (wn - omegas[nw - 2]).max(1e-3 * wn);
+    let mut x = wn + step;
+    while x <= super::radiation::TAIL_END_FACTOR * wn {
+        rows.push((freqs.len(), false));
+        freqs.push(x);
+        step *= TAIL_SPREAD;
+        x += step;
+    }
+    (freqs, rows)
+}
+
+/// The scaled kernel of each entry (i, j) of the upper triangle at each of `freqs` ([`fit_rows`]): the
+/// symmetric parts of the data, B linear to 0 below it, the damping tail above it.
+#[allow(clippy::too_many_arguments)]
+fn fit_data(
+    entries: &[(usize, usize)],
+    freqs: &[f64],
+    omegas: &[f64],
+    damping: &[DMatrix<f64>],
+    added_mass: &[DMatrix<f64>],
+    a_inf: &DMatrix<f64>,
+    tail: &DampingTail,
+    sc: &dyn Fn(usize, usize) -> f64,
+) -> Vec<Vec<Complex64>> {
+    let nw = omegas.len();
+    entries
+        .iter()
+        .map(|&(i, j)| {
+            freqs
+                .iter()
+                .enumerate()
+                .map(|(k, w)| {
+                    if k < nw {
+                        // the symmetric parts (a BEM's matrices are symmetric up to its discretization)
+                        let b = 0.5 * (damping[k][(i, j)] + damping[k][(j, i)]);
+                        let a = 0.5 * (added_mass[k][(i, j)] + added_mass[k][(j, i)]);
+                        Complex64::new(b, w * (a - a_inf[(i, j)])) / sc(i, j)
+                    } else if *w < omegas[0] {
+                        let b = 0.5 * (damping[0][(i, j)] + damping[0][(j, i)]);
+                        Complex64::new(b * w / omegas[0] / sc(i, j), 0.0)
+                    } else {
+                        let b = tail.at(*w);
+                        Complex64::new(0.5 * (b[(i, j)] + b[(j, i)]) / sc(i, j), 0.0)
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Fits the kernel K(iw) = B(w) + i w (A(w) - A_inf) at ascending `omegas` (n x n each, B passive) and
 /// returns the reduced modal model.
 pub fn fit(
@@ -215,52 +283,9 @@ pub fn fit(
     let sc = |i: usize, j: usize| (scale[i] * scale[j]).sqrt();
     // the upper triangle, scaled: entry e = (i, j), data[e][k]
     let entries: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
-    // rows: the data (damping and added mass), then B(0) = 0 and the IRF's damping tail beyond the data
-    // (damping only: the added mass there is unknown), so the fit stays passive where the data end
     let wn = omegas[nw - 1];
-    let mut freqs: Vec<f64> = omegas.to_vec();
-    let mut rows: Vec<(usize, bool)> = (0..nw).map(|k| (k, false)).collect();
-    // B(0) = 0 and, below the data, B linear to 0 as the convolution's IRF integrates it (the low
-    // frequencies set the zero-frequency added mass, hence the drift of modes without restoring)
-    freqs.push(0.0);
-    rows.push((nw, false));
-    for k in 1..LOW_ROWS {
-        rows.push((freqs.len(), false));
-        freqs.push(omegas[0] * k as f64 / LOW_ROWS as f64);
-    }
-    // tail nodes as dense as the data at the band's edge, spreading out by TAIL_SPREAD per node (a
-    // sparse tail let a spurious lightly damped pole sit just above the band on the one-ship demo)
-    let mut step = (wn - omegas[nw - 2]).max(1e-3 * wn);
-    let mut x = wn + step;
-    while x <= super::radiation::TAIL_END_FACTOR * wn {
-        rows.push((freqs.len(), false));
-        freqs.push(x);
-        step *= TAIL_SPREAD;
-        x += step;
-    }
-    let data: Vec<Vec<Complex64>> = entries
-        .iter()
-        .map(|&(i, j)| {
-            freqs
-                .iter()
-                .enumerate()
-                .map(|(k, w)| {
-                    if k < nw {
-                        // the symmetric parts (a BEM's matrices are symmetric up to its discretization)
-                        let b = 0.5 * (damping[k][(i, j)] + damping[k][(j, i)]);
-                        let a = 0.5 * (added_mass[k][(i, j)] + added_mass[k][(j, i)]);
-                        Complex64::new(b, w * (a - a_inf[(i, j)])) / sc(i, j)
-                    } else if *w < omegas[0] {
-                        let b = 0.5 * (damping[0][(i, j)] + damping[0][(j, i)]);
-                        Complex64::new(b * w / omegas[0] / sc(i, j), 0.0)
-                    } else {
-                        let b = tail.at(*w);
-                        Complex64::new(0.5 * (b[(i, j)] + b[(j, i)]) / sc(i, j), 0.0)
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let (freqs, rows) = fit_rows(omegas);
+    let data = fit_data(&entries, &freqs, omegas, damping, added_mass, a_inf, tail, &sc);
     if data.iter().flatten().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
         return Err(FitError("the damping or added mass is not finite".into()));
     }
@@ -324,9 +349,8 @@ pub fn fit(
 /// (CHECK_POINTS + 1 points), plus points within 8 half-widths of every pole narrower than 4 grid spacings.
 pub fn check_grid(poles: &[Complex64], omega_max: f64) -> Vec<f64> {
     let dw = CHECK_SPAN * omega_max / CHECK_POINTS as f64;
-    // w = 0 included: a negative Re K(0) is a drag that pushes a free drift (measured on WEC-Sim's RM3
-    // once slow modes were held in the enforcement: -9e-5 of the peak damping on every heave, unseen
-    // while the grid began at dw)
+    // w = 0 included: a negative Re K(0) is a drag that pushes a free drift, and a grid beginning at dw
+    // does not see it
     let mut grid: Vec<f64> = (0..=CHECK_POINTS).map(|k| k as f64 * dw).collect();
     for p in poles {
         let hw = p.re.abs().max(1e-9);
@@ -423,16 +447,8 @@ fn violations(
 /// 1 + (w_low / |lambda|)^2 with w_low = `low_band_rad_s`: a residue change dr at pole lambda moves the
 /// added mass at low frequency by about dr / |lambda|^2 (r / (iw - lambda) to first order in w), and the
 /// response of a DOF without restoring is its mass there, so slow modes pay for that leverage.
-/// Measured on the pair demo (worst |difference| / curve peak of the state-space floor against the
-/// convolution's, lighter yaw in beam seas at 0.05 rad/s): 2.16 % with the share alone; w_low = 0.1 /
-/// 0.3 / 1 / 3 rad/s: 1.40 / 1.18 / 1.22 / 1.28 % (the fit uses 0.28 rad/s there; 1.25 % once w = 0 joined
-/// the check grid).
-/// Tried and dropped (session 14, pair demo): holding Re K(0) = 0 (every entry, scaled) as equality rows
-/// beside the violations, w = 0 taken off the margin (and, a second try, the margin scaled by (w / w_1)^2
-/// below the lowest database frequency w_1): 30 passes did not converge (violations kept returning
-/// between 0.03 and 0.4 rad/s, K(0) between 1e-7 and 6e-5 of scale pass to pass) and the floor against
-/// the convolution's went from 1.25 % to 10-12 % (lighter yaw, beam seas, 0.15 rad/s). K(0) = 0 with
-/// Re K >= 0 beside it asks a PSD curvature at w = 0 the low band's tiny damping does not have.
+/// Re K(0) is not held at zero: K(0) = 0 with Re K >= 0 beside it asks a PSD curvature at w = 0 that the
+/// low band's tiny damping does not have, and the enforcement does not converge with it.
 fn enforce_passivity(
     poles: &[Complex64],
     mut b: DMatrix<Complex64>,
@@ -808,10 +824,9 @@ impl Realization {
     }
 
     /// Square-root balanced truncation: (A_r, B_r, C_r) and the Hankel singular values.
-    /// Measured and not used (session 14, pair demo, 480 states to 219): singular perturbation instead of
-    /// truncation keeps the fit's K(0) = 0, but moves the same error to infinite frequency as a
-    /// feedthrough D_r = -C_2 A_22^-1 B_2 of both signs (largest 1.1e-4 scaled, eigenvalues -1.7e-4 to
-    /// 1.9e-4; truncation's K(0): largest 1.4e-4, -1.8e-4 to 2.8e-4): a damping that no residue reaches.
+    /// Truncation, not singular perturbation: the latter keeps the fit's K(0) = 0 but moves the same
+    /// error to infinite frequency as a feedthrough D_r = -C_2 A_22^-1 B_2 of both signs, a damping that
+    /// no residue reaches.
     fn balanced_truncation(&self, tol: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, Vec<f64>) {
         let n = self.n;
         let nb = self.s.len();
