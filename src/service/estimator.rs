@@ -30,12 +30,6 @@
 //!   the status reports the estimate). It is taken off the initial displacement once it has averaged
 //!   over a fifth of that time. The velocity history is not affected by a constant bias. DOFs without
 //!   restoring have no observable bias.
-//! - Free drift: a DOF with no restoring at all (surge, sway, yaw of a vessel without lines or fenders)
-//!   carries whatever mean velocity it starts with through the whole forecast, and the linear model has
-//!   no force that would explain one (mean drift forces are second order): a slow drift, or the
-//!   sensor's velocity noise, would become metres at two minutes' lead. Its mean velocity over the
-//!   history the forecast reads (velocities and the initial one) is taken out: the forecast is of the
-//!   oscillation about the current position.
 
 use std::collections::VecDeque;
 
@@ -113,9 +107,6 @@ pub struct Spec {
     pub bounds: Bounds,
     /// DOFs whose bias is estimated (hydrostatic restoring).
     pub restored: [bool; 6],
-    /// DOFs with no restoring at all (no hydrostatics, lines or fenders): their mean velocity over
-    /// the history is taken out of the state and the history the forecast starts from.
-    pub free: [bool; 6],
     pub bias_time_s: f64,
     pub gate_sigma: f64,
     pub reset_samples: usize,
@@ -592,15 +583,6 @@ impl Estimator {
                 out.velocities[n - m] = v;
             }
         }
-        if self.spec.method == Method::Kalman {
-            for d in (0..6).filter(|d| self.spec.free[*d]) {
-                let mean = (out.v0[d] + out.velocities.iter().map(|v| v[d]).sum::<f64>()) / (n + 1) as f64;
-                out.v0[d] -= mean;
-                for v in out.velocities.iter_mut() {
-                    v[d] -= mean;
-                }
-            }
-        }
         Some(out)
     }
 }
@@ -622,7 +604,6 @@ mod tests {
             q,
             bounds: Bounds::from_system(&nalgebra::Matrix6::from_diagonal_element(1e6), 9.81, 2.0, 0.2),
             restored: [false, false, true, true, true, false],
-            free: [true, false, false, false, false, false],
             bias_time_s: 100.0,
             gate_sigma: 5.0,
             reset_samples: 5,
@@ -828,30 +809,5 @@ mod tests {
         assert!(r.short);
         // t0 after the newest sample: nothing
         assert!(h.resample(10.5, 0.1, 5, 1.0).is_none());
-    }
-
-    #[test]
-    fn a_free_mode_s_mean_velocity_is_taken_out_of_the_state() {
-        // surge (free) oscillating at 0.6 rad/s on a drift of 0.05 m/s
-        let mut e = Estimator::new(spec(Method::Kalman), 300.0);
-        for k in 0..=1000 {
-            let t = k as f64 * 0.1;
-            let mut x = [0.0; 6];
-            let mut v = [0.0; 6];
-            x[0] = 0.05 * t + 0.5 * (0.6 * t).sin();
-            v[0] = 0.05 + 0.3 * (0.6 * t).cos();
-            e.push(t, x, v).unwrap();
-        }
-        // a 62.8 s history: six whole periods of the oscillation
-        let n = 628;
-        let r = e.resample(100.0, 0.1, n, 1.0).unwrap();
-        assert!((r.v0[0] - 0.3 * 60f64.cos()).abs() < 0.01, "{}", r.v0[0]);
-        let mean = r.velocities.iter().map(|v| v[0]).sum::<f64>() / n as f64;
-        assert!(mean.abs() < 0.01, "{mean}");
-        assert!(
-            (r.x0[0] - (5.0 + 0.5 * 60f64.sin())).abs() < 0.01,
-            "the position stays: {}",
-            r.x0[0]
-        );
     }
 }

@@ -328,7 +328,7 @@ fn refusal_text(why: &Refusal) -> String {
 
 /// The estimator of vessel `b`: the configured sensor and gate, bounds from the body and the
 /// database, the bandwidth from the database's highest frequency, the bias on the DOFs with
-/// hydrostatic restoring, the mean velocity out of the DOFs with no restoring at all.
+/// hydrostatic restoring.
 pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeModel, b: usize) -> estimator::Spec {
     let e = &cfg.estimator;
     let (omega_min, omega_max) = model.db.omega_range();
@@ -351,16 +351,16 @@ pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeMode
             omega_min,
         ),
         restored: [false; 6],
-        free: [false; 6],
         bias_time_s: e.bias_time_s,
         gate_sigma: e.gate_sigma,
         reset_samples: e.reset_samples as usize,
     };
     for d in 0..6 {
         spec.q[d] = estimator::Spec::process_noise(spec.noise_x[d], estimator::BANDWIDTH_FACTOR * omega_max);
-        if let Some(row) = model.active.iter().position(|&i| i == 6 * b + d) {
-            spec.restored[d] = (2..5).contains(&d) && model.stiffness[(row, row)] > 0.0;
-            spec.free[d] = model.stiffness_linearized[(row, row)] <= 0.0;
+        if (2..5).contains(&d)
+            && let Some(row) = model.active.iter().position(|&i| i == 6 * b + d)
+        {
+            spec.restored[d] = model.stiffness[(row, row)] > 0.0;
         }
     }
     spec
