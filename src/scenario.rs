@@ -264,7 +264,7 @@ impl Prepared {
             v0: &self.v0,
             memory: &self.memory,
             waves: &self.waves,
-            horizon_s: length_s,
+            length_s,
             ramp_s: 0.0,
         }
     }
@@ -306,7 +306,7 @@ pub fn prepare(past: &TimeModel, model: &TimeModel, waves: &Waves, history_s: f6
             v0: &zeros,
             memory: &rest,
             waves: &waves,
-            horizon_s: history_s,
+            length_s: history_s,
             ramp_s: 30.0_f64.min(history_s / 2.0),
         },
     )?;

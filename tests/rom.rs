@@ -312,7 +312,7 @@ fn run_from_rest_history(
     x0: &[f64],
     v0: &[f64],
     waves: &[WaveComponent],
-    horizon_s: f64,
+    length_s: f64,
     ramp_s: f64,
 ) -> shipcast::rom::Result<Forecast> {
     let mem = Memory::new(model);
@@ -324,7 +324,7 @@ fn run_from_rest_history(
             v0,
             memory: &mem,
             waves,
-            horizon_s,
+            length_s,
             ramp_s,
         },
     )

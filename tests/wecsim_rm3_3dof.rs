@@ -117,7 +117,7 @@ fn forces_sample_by_sample_match_wecsim() {
         v0: &z,
         memory: &mem,
         waves: &waves,
-        horizon_s: DURATION_S,
+        length_s: DURATION_S,
         ramp_s: RAMP_S,
     };
     let force = Forecaster::new().force_for(&m, &req).unwrap();

@@ -31,9 +31,8 @@ pub struct ForecastRequest<'a> {
     pub memory: &'a Memory,
     /// Wave components in the seakeeping frame, amplitudes at the origin at t0.
     pub waves: &'a [WaveComponent],
-    /// Forecast length, s (the field keeps the daemon's `forecast.horizon_s` name: it is not the
-    /// predictable horizon).
-    pub horizon_s: f64,
+    /// Forecast length, s (not the predictable horizon).
+    pub length_s: f64,
     /// Optional ramp of the wave force over its first seconds (regular-wave runs), s; 0 = none.
     pub ramp_s: f64,
 }
@@ -175,7 +174,7 @@ impl Forecaster {
     pub fn forecast(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<&Forecast> {
         let n = model.n();
         let dt = model.opts.dt_s;
-        let length_s = req.horizon_s;
+        let length_s = req.length_s;
         if !(length_s.is_finite() && length_s > 0.0 && length_s <= MAX_FORECAST_LENGTH_S) {
             return Err(Error::Input(format!(
                 "forecast length {length_s} s: must be in (0, {MAX_FORECAST_LENGTH_S}] s"
@@ -246,7 +245,7 @@ impl Forecaster {
             v0: &z,
             memory: &memory,
             waves,
-            horizon_s: length_s,
+            length_s,
             ramp_s,
         };
         self.forecast(model, &req)
@@ -255,7 +254,7 @@ impl Forecaster {
     /// The wave force a request implies at t0 + k dt, k = 0..steps (k-major, active DOFs), through the
     /// same code as a forecast.
     pub fn force_for(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<Vec<f64>> {
-        let steps = (req.horizon_s / model.opts.dt_s).round() as usize;
+        let steps = (req.length_s / model.opts.dt_s).round() as usize;
         self.wave_force(model, req.waves, steps, req.ramp_s)?;
         Ok(self.force.clone())
     }

@@ -163,7 +163,7 @@ fn run_until(
             v0: &zeros,
             memory: &memory,
             waves,
-            horizon_s: limit as f64 * dt,
+            length_s: limit as f64 * dt,
             ramp_s,
         },
     )?;

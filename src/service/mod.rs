@@ -131,16 +131,17 @@ pub struct Computer {
     model: TimeModel,
     fc: Forecaster,
     n_bodies: usize,
-    horizon_s: f64,
+    /// Forecast length, s.
+    length_s: f64,
 }
 
 impl Computer {
-    pub fn new(model: TimeModel, n_bodies: usize, horizon_s: f64) -> Computer {
+    pub fn new(model: TimeModel, n_bodies: usize, length_s: f64) -> Computer {
         Computer {
             model,
             fc: Forecaster::new(),
             n_bodies,
-            horizon_s,
+            length_s,
         }
     }
 
@@ -154,7 +155,7 @@ impl Computer {
                 v0: &job.v0,
                 memory: &memory,
                 waves: &job.waves,
-                horizon_s: self.horizon_s,
+                length_s: self.length_s,
                 ramp_s: 0.0,
             };
             fc.forecast(model, &req).map(|f| {
@@ -771,6 +772,58 @@ impl Engine {
     }
 }
 
+/// The daemon's recorder (`[record]`), or None when it records nothing or cannot (logged).
+fn open_recorder(cfg: &ShipcastConfig, sys: &VesselSystem) -> Option<crate::record::RotatingRecorder> {
+    if cfg.record.dir.is_empty() {
+        return None;
+    }
+    let dir = cfg.dir.join(&cfg.record.dir);
+    match crate::record::RotatingRecorder::new(
+        &dir,
+        cfg.record.rotate_mb,
+        cfg.record.rotate_s,
+        crate::record::LogInfo::of(cfg, &cfg.system.file, sys, "daemon"),
+    ) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            tracing::error!("recording disabled: {e}");
+            None
+        }
+    }
+}
+
+/// One record into the recording; a write error ends the recording (logged), never the daemon.
+fn record(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, r: crate::record::Record) {
+    if let Some(rec) = recorder.as_mut()
+        && let Err(e) = rec.record(t, &r)
+    {
+        tracing::error!("recording stopped: {e}");
+        *recorder = None;
+    }
+}
+
+/// An input as it arrived, into the recording.
+fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, msg: &Input) {
+    use crate::record::{MotionRecord, Record, WavesRecord};
+    if recorder.is_none() {
+        return;
+    }
+    match msg {
+        Input::Motion(m) => record(
+            recorder,
+            t,
+            Record::Motion(MotionRecord {
+                vessel: m.vessel,
+                time_s: m.time_s,
+                x: m.x,
+                v: m.v,
+            }),
+        ),
+        Input::Waves(f) => record(recorder, t, Record::Waves(WavesRecord::of(f))),
+        Input::Rejected(_) => {}
+    }
+}
+
 /// The daemon (and a replay of its log) forecasts at most [`MAX_VESSELS`] vessels: the forecast and
 /// status payloads carry no more.
 pub fn fits_the_wire(sys: &VesselSystem) -> Result<(), String> {
@@ -853,31 +906,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
     // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
     // decision); a write error is logged and ends the recording, never the daemon
-    let mut recorder = if cfg.record.dir.is_empty() {
-        None
-    } else {
-        let dir = cfg.dir.join(&cfg.record.dir);
-        match crate::record::RotatingRecorder::new(
-            &dir,
-            cfg.record.rotate_mb,
-            cfg.record.rotate_s,
-            crate::record::LogInfo::of(&cfg, &cfg.system.file, &sys, "daemon"),
-        ) {
-            Ok(r) => Some(r),
-            Err(e) => {
-                tracing::error!("recording disabled: {e}");
-                None
-            }
-        }
-    };
-    fn record(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, r: crate::record::Record) {
-        if let Some(rec) = recorder.as_mut()
-            && let Err(e) = rec.record(t, &r)
-        {
-            tracing::error!("recording stopped: {e}");
-            *recorder = None;
-        }
-    }
+    let mut recorder = open_recorder(&cfg, &sys);
     let mut failure: Option<&str> = None;
     loop {
         tokio::select! {
@@ -887,16 +916,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
             msg = in_rx.recv() => {
                 let Some(msg) = msg else { break };
                 let t = clock();
-                if recorder.is_some() {
-                    use crate::record::{MotionRecord, Record, WavesRecord};
-                    match &msg {
-                        Input::Motion(m) => record(&mut recorder, t, Record::Motion(MotionRecord {
-                            vessel: m.vessel, time_s: m.time_s, x: m.x, v: m.v,
-                        })),
-                        Input::Waves(f) => record(&mut recorder, t, Record::Waves(WavesRecord::of(f))),
-                        Input::Rejected(_) => {}
-                    }
-                }
+                record_input(&mut recorder, t, &msg);
                 engine.input(msg, t);
             }
             done = done_rx.recv() => {
