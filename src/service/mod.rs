@@ -772,6 +772,22 @@ impl Engine {
     }
 }
 
+/// The model and the engine of a configuration, built and logged.
+fn build(cfg: &ShipcastConfig, sys: &VesselSystem) -> Result<(TimeModel, Engine), Error> {
+    let t_build = Instant::now();
+    let model = TimeModel::new(sys, rom_options(cfg, sys))?;
+    let engine = Engine::new(cfg, sys, &model);
+    tracing::info!(
+        vessels = sys.spec.bodies.len(),
+        active_dofs = model.n(),
+        memory_s = engine.memory_s(),
+        step = %describe_step(cfg, sys),
+        build_s = t_build.elapsed().as_secs_f64(),
+        "model ready"
+    );
+    Ok((model, engine))
+}
+
 /// The daemon's recorder (`[record]`), or None when it records nothing or cannot (logged).
 fn open_recorder(cfg: &ShipcastConfig, sys: &VesselSystem) -> Option<crate::record::RotatingRecorder> {
     if cfg.record.dir.is_empty() {
@@ -858,17 +874,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     watchdog_fits(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6))?;
     fits_the_wire(&sys)?;
     let n_bodies = sys.spec.bodies.len();
-    let t_build = Instant::now();
-    let model = TimeModel::new(&sys, rom_options(&cfg, &sys))?;
-    let mut engine = Engine::new(&cfg, &sys, &model);
-    tracing::info!(
-        vessels = n_bodies,
-        active_dofs = model.n(),
-        memory_s = engine.memory_s(),
-        step = %describe_step(&cfg, &sys),
-        build_s = t_build.elapsed().as_secs_f64(),
-        "model ready"
-    );
+    let (model, mut engine) = build(&cfg, &sys)?;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
     };
