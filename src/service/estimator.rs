@@ -20,12 +20,15 @@
 //! - Physically impossible samples are refused before they reach the filter: a displacement, velocity
 //!   or acceleration beyond bounds from the system (`Bounds::from_system`), or a change since the last
 //!   estimate that no acceleration within the bound could make over the time between them (beyond
-//!   `gate_sigma` standard deviations of the noise and the estimate's own uncertainty). A refused
-//!   sample never enters the filter, the smoother or the radiation history.
+//!   `gate_sigma` standard deviations of the noise and the estimate's own uncertainty), or a stalled
+//!   sensor: every value the same as in the two samples before, once the vessel has been seen moving
+//!   (the stall's first two outputs are taken back). A refused sample never enters the filter, the
+//!   smoother or the radiation history.
 //! - A real jump (a sensor re-zeroed) is told from a spike by persistence: `reset_samples` refused
 //!   samples in a row that agree with each other restart the estimate from them.
 //! - Sensor bias: the displacement of a DOF with hydrostatic restoring (heave, roll, pitch) has zero
-//!   mean about the equilibrium in linear waves, so its long average (time constant `bias_time_s`) is
+//!   mean about the equilibrium in linear waves, so its long average (time constant `bias_time_s`,
+//!   each sample counting for the time since the one before, at most `BIAS_MAX_INTERVAL_S`) is
 //!   the sensor's bias (or a static heel or trim: the two cannot be told apart from the motion alone;
 //!   the status reports the estimate). It is taken off the initial displacement once it has averaged
 //!   over a fifth of that time. The velocity history is not affected by a constant bias. DOFs without
@@ -39,6 +42,11 @@ pub const BANDWIDTH_FACTOR: f64 = 4.0;
 /// Samples closer than this to the newest taken are refused as duplicates: the kept window holds at
 /// most 1000 samples a second, whatever a sensor sends.
 pub const MIN_SAMPLE_INTERVAL_S: f64 = 1e-3;
+
+/// A sample repeating every value of the one before this many times in a row is a stalled sensor.
+pub const STALL_REPEATS: usize = 2;
+/// In the bias average a sample counts for the time since the one before, at most this, s.
+pub const BIAS_MAX_INTERVAL_S: f64 = 1.0;
 
 /// How a vessel's samples become its state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -127,8 +135,8 @@ pub enum Refusal {
     Late,
     /// The same stamp as the newest taken, or less than [`MIN_SAMPLE_INTERVAL_S`] after it.
     Duplicate,
-    /// The same values as the sample before, while the vessel was moving: a stalled sensor repeating
-    /// its last output (or zeros, an empty field read as 0).
+    /// The same values as the two samples before, once the vessel has been seen moving: a stalled
+    /// sensor repeating its last output (or zeros, an empty field read as 0).
     Frozen,
     /// Beyond a bound: the DOF, what (displacement, velocity), the value and the bound.
     Bound {
@@ -240,8 +248,13 @@ pub struct Estimator {
     bias: Bias,
     /// Refused samples in a row that agree with each other, filtered from the first of them.
     candidate: Vec<Entry>,
-    /// The values of the last sample received (taken or not).
+    /// The values of the last sample received (taken or not), and how many received in a row
+    /// before it had the same.
     last_received: Option<([f64; 6], [f64; 6])>,
+    repeats: usize,
+    /// A taken sample has differed from the one before it (kept across a restart: the sensor has
+    /// been seen moving).
+    moved: bool,
 }
 
 impl Estimator {
@@ -254,6 +267,8 @@ impl Estimator {
             bias: Bias::default(),
             candidate: vec![],
             last_received: None,
+            repeats: 0,
+            moved: false,
         }
     }
 
@@ -370,23 +385,26 @@ impl Estimator {
                 return Err(Refusal::Duplicate);
             }
         }
-        let repeated = self.last_received == Some((x, v));
+        self.repeats = if self.last_received == Some((x, v)) {
+            self.repeats + 1
+        } else {
+            0
+        };
         self.last_received = Some((x, v));
-        if self.spec.method == Method::Kalman {
-            if repeated {
-                // a sensor's noise never repeats all its values: a repeat is a stalled sensor, unless
-                // the vessel has read the same from its first sample on (at rest, noise-free). The
-                // stall's first output, taken before it repeated, is taken back.
-                let same = |e: &Entry| e.x == x && e.v == v;
-                let n = self.entries.len();
-                let at_rest_from_start = self.entries.iter().all(same);
-                if !at_rest_from_start {
-                    if n >= 2 && same(&self.entries[n - 1]) {
+        if self.spec.method == Method::Kalman && self.repeats >= STALL_REPEATS && self.moved {
+            // a sensor's noise never repeats all its values three times: a stalled sensor (a
+            // sensor that sends each value twice is not one). Its first outputs, taken before they
+            // repeated, are taken back. A vessel never seen moving (at rest, noise-free) is not stalled.
+            if self.repeats == STALL_REPEATS {
+                for _ in 0..STALL_REPEATS {
+                    if self.entries.len() > 2 && self.entries.back().is_some_and(|e| e.x == x && e.v == v) {
                         self.entries.pop_back();
                     }
-                    return Err(Refusal::Frozen);
                 }
             }
+            return Err(Refusal::Frozen);
+        }
+        if self.spec.method == Method::Kalman {
             let b = &self.spec.bounds;
             for d in 0..6 {
                 if x[d].abs() > b.max_x[d] {
@@ -423,7 +441,7 @@ impl Estimator {
     /// restart the estimate from them.
     fn refused(&mut self, why: Refusal, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Result<Taken, Refusal> {
         let next = match self.candidate.last() {
-            Some(prev) if time_s > prev.time_s => self.follow(prev, time_s, x, v).ok(),
+            Some(prev) if time_s - prev.time_s >= MIN_SAMPLE_INTERVAL_S => self.follow(prev, time_s, x, v).ok(),
             _ => None,
         };
         match next {
@@ -443,7 +461,10 @@ impl Estimator {
 
     fn take(&mut self, e: Entry) {
         if let Some(prev) = self.entries.back() {
-            let dt = e.time_s - prev.time_s;
+            self.moved |= prev.x != e.x || prev.v != e.v;
+            // a sample after a gap counts for a second at most: one reading does not stand for the
+            // whole silence
+            let dt = (e.time_s - prev.time_s).min(BIAS_MAX_INTERVAL_S);
             self.bias.span_s += dt;
             let w = (dt / self.spec.bias_time_s.min(self.bias.span_s)).min(1.0);
             for d in 0..6 {
@@ -765,8 +786,22 @@ mod tests {
             e.push(t, x, v).unwrap();
         }
         assert_eq!(e.push(50.1, [0.0; 6], [0.0; 6]), Ok(Taken::Accepted));
-        assert_eq!(e.push(50.2, [0.0; 6], [0.0; 6]), Err(Refusal::Frozen));
+        assert_eq!(e.push(50.2, [0.0; 6], [0.0; 6]), Ok(Taken::Accepted));
+        assert_eq!(e.push(50.3, [0.0; 6], [0.0; 6]), Err(Refusal::Frozen));
         assert_eq!(e.newest_time_s(), Some(50.0));
+        // ... and after a restart (a step of its clock) it is still a moving vessel's stall
+        e.restart();
+        for k in 0..3 {
+            let _ = e.push(60.0 + 0.1 * k as f64, [0.0; 6], [0.0; 6]);
+        }
+        assert_eq!(e.push(60.3, [0.0; 6], [0.0; 6]), Err(Refusal::Frozen));
+        // a sensor sending each value twice is not stalled
+        let mut twice = Estimator::new(spec(Method::Kalman), 300.0);
+        for k in 0..200 {
+            let t = k as f64 * 0.05;
+            let (x, v) = wave(0.1 * (k / 2) as f64);
+            assert_eq!(twice.push(t, x, v), Ok(Taken::Accepted), "{k}");
+        }
         // a vessel at rest, measured so, is not frozen
         let mut rest = Estimator::new(spec(Method::Kalman), 300.0);
         for k in 0..10 {
