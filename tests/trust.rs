@@ -114,6 +114,19 @@ fn baseline() -> &'static Run {
     RUN.get_or_init(|| drive(&log().records))
 }
 
+/// The faulted run issues as many forecasts after the fault as the unfaulted one (two fewer at most).
+fn forecasts_go_on(records: &[(f64, Record)], run: &Run, fault: &str) {
+    let t0 = start(records);
+    let (base, got) = (
+        after(baseline(), t0, FAULT_AT_S).len(),
+        after(run, t0, FAULT_AT_S).len(),
+    );
+    assert!(
+        got + 2 >= base,
+        "{got} forecasts after {fault} against {base} without it"
+    );
+}
+
 /// The index of the first record of `kind` at or after `at_s` seconds into the log.
 fn first_after(records: &[(f64, Record)], at_s: f64, waves: bool) -> usize {
     let t0 = start(records);
@@ -177,15 +190,7 @@ fn one_motion_sample_stamped_an_hour_ahead_is_refused_and_forecasts_go_on() {
             m.time_s += 3600.0;
         }
     });
-    let t0 = start(&records);
-    let (base, got) = (
-        after(baseline(), t0, FAULT_AT_S).len(),
-        after(&run, t0, FAULT_AT_S).len(),
-    );
-    assert!(
-        got + 2 >= base,
-        "{got} forecasts after the fault against {base} without it"
-    );
+    forecasts_go_on(&records, &run, "the fault");
     assert_eq!(run.statuses.last().unwrap().dropped_future, 1);
 }
 
@@ -390,14 +395,8 @@ fn an_absurd_motion_sample_is_refused_and_never_enters_the_history() {
             m.v = [1e6; 6];
         }
     });
+    forecasts_go_on(&records, &run, "the spike");
     let t0 = start(&records);
-    let (base, got) = (after(baseline(), t0, FAULT_AT_S), after(&run, t0, FAULT_AT_S));
-    assert!(
-        got.len() + 2 >= base.len(),
-        "{} forecasts after the spike against {} without it",
-        got.len(),
-        base.len()
-    );
     // the forecasts after the spike are those without it: the spike is not in their state or history
     let largest = |run: &Run| {
         run.forecasts
@@ -426,15 +425,7 @@ fn a_wave_field_of_a_million_components_is_refused_and_forecasts_go_on() {
         }
     });
     assert_eq!(run.statuses.last().unwrap().dropped_rejected, 1);
-    let t0 = start(&records);
-    let (base, got) = (
-        after(baseline(), t0, FAULT_AT_S).len(),
-        after(&run, t0, FAULT_AT_S).len(),
-    );
-    assert!(
-        got + 2 >= base,
-        "{got} forecasts after the field against {base} without it"
-    );
+    forecasts_go_on(&records, &run, "the field");
 }
 
 /// Was: a replay of a system with more than 4 bodies (more than the payloads carry) panicked.

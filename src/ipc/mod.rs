@@ -123,13 +123,7 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
             h.schema_version
         ));
     }
-    if h.n_components as usize > crate::ipc::wire::MAX_WAVE_COMPONENTS {
-        return Err(format!(
-            "wave field of {} components, more than {} (a 256 x 256 radar grid's wavenumber bins)",
-            h.n_components,
-            crate::ipc::wire::MAX_WAVE_COMPONENTS
-        ));
-    }
+    crate::ipc::wire::check_wave_components(h.n_components as usize)?;
     if payload.len() != 4 * h.n_components as usize {
         return Err(format!(
             "wave field: {} values for {} components (4 each)",

@@ -31,6 +31,17 @@ pub const MAX_VESSELS: usize = 4;
 /// forecaster's buffers grow to the largest field seen).
 pub const MAX_WAVE_COMPONENTS: usize = 65_536;
 
+/// The one check of a wave field's size, for the decoder (before it allocates) and the engine (fields
+/// from a log).
+pub fn check_wave_components(n: usize) -> Result<(), String> {
+    if n > MAX_WAVE_COMPONENTS {
+        return Err(format!(
+            "wave field of {n} components, more than {MAX_WAVE_COMPONENTS} (a 256 x 256 radar grid's wavenumber bins)"
+        ));
+    }
+    Ok(())
+}
+
 /// Quality flags of forecasts and status (bits).
 pub mod flags {
     /// The newest wave field is older than `max_wave_age_s`.

@@ -186,14 +186,10 @@ impl Gauss {
     /// The update with a measurement of both (variances rx, rv).
     fn update(&self, z: [f64; 2], rx: f64, rv: f64) -> Gauss {
         let [pp, pv, vv] = self.p;
-        let (s00, s01, s11) = (pp + rx, pv, vv + rv);
-        let det = s00 * s11 - s01 * s01;
-        // K = P S^-1
-        let (i00, i01, i11) = (s11 / det, -s01 / det, s00 / det);
-        let k00 = pp * i00 + pv * i01;
-        let k01 = pp * i01 + pv * i11;
-        let k10 = pv * i00 + vv * i01;
-        let k11 = pv * i01 + vv * i11;
+        // K = P S^-1 (S = P + R is positive definite: the noise variances are positive)
+        let Some([k00, k01, k10, k11]) = times_inverse([pp, pv, pv, vv], [pp + rx, pv, vv + rv]) else {
+            return *self;
+        };
         let (n0, n1) = (z[0] - self.m[0], z[1] - self.m[1]);
         // P - K P (symmetric up to rounding: the symmetric part kept)
         let q00 = pp - (k00 * pp + k01 * pv);
@@ -204,6 +200,24 @@ impl Gauss {
             p: [q00.max(0.0), q01, q11.max(0.0)],
         }
     }
+}
+
+/// A S^-1 for a 2 x 2 `a` (row-major) and a symmetric `s` (s00, s01, s11); None unless S is positive
+/// definite (the Kalman gain and the smoother's gain).
+fn times_inverse(a: [f64; 4], s: [f64; 3]) -> Option<[f64; 4]> {
+    let [s00, s01, s11] = s;
+    let det = s00 * s11 - s01 * s01;
+    if !(det.is_finite() && det > 0.0) {
+        return None;
+    }
+    let (i00, i01, i11) = (s11 / det, -s01 / det, s00 / det);
+    let [a00, a01, a10, a11] = a;
+    Some([
+        a00 * i00 + a01 * i01,
+        a00 * i01 + a01 * i11,
+        a10 * i00 + a11 * i01,
+        a10 * i01 + a11 * i11,
+    ])
 }
 
 /// One sample the filter took.
@@ -504,18 +518,12 @@ impl Estimator {
                 // C = P_k Phi^T Ppred^-1, Phi = [[1, dt], [0, 1]]
                 let [pp, pv, vv] = f.p;
                 let (a00, a01, a10, a11) = (pp + dt * pv, pv, pv + dt * vv, vv);
-                let [qp, qpv, qv] = pr.p;
-                let det = qp * qv - qpv * qpv;
-                if !(det.is_finite() && det > 0.0) {
-                    ms = f.m;
-                } else {
-                    let (i00, i01, i11) = (qv / det, -qpv / det, qp / det);
-                    let c00 = a00 * i00 + a01 * i01;
-                    let c01 = a00 * i01 + a01 * i11;
-                    let c10 = a10 * i00 + a11 * i01;
-                    let c11 = a10 * i01 + a11 * i11;
-                    let (r0, r1) = (ms[0] - pr.m[0], ms[1] - pr.m[1]);
-                    ms = [f.m[0] + c00 * r0 + c01 * r1, f.m[1] + c10 * r0 + c11 * r1];
+                match times_inverse([a00, a01, a10, a11], pr.p) {
+                    None => ms = f.m,
+                    Some([c00, c01, c10, c11]) => {
+                        let (r0, r1) = (ms[0] - pr.m[0], ms[1] - pr.m[1]);
+                        ms = [f.m[0] + c00 * r0 + c01 * r1, f.m[1] + c10 * r0 + c11 * r1];
+                    }
                 }
                 out[k].1[d] = ms[0];
                 out[k].2[d] = ms[1];

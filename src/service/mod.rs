@@ -543,16 +543,9 @@ impl Engine {
             }
             Input::Waves(f) => {
                 c.wave_fields += 1;
-                if f.components.len() > crate::ipc::wire::MAX_WAVE_COMPONENTS {
+                if let Err(why) = crate::ipc::wire::check_wave_components(f.components.len()) {
                     c.rejected += 1;
-                    log_count(
-                        c.rejected,
-                        &format!(
-                            "wave field of {} components refused: more than {}",
-                            f.components.len(),
-                            crate::ipc::wire::MAX_WAVE_COMPONENTS
-                        ),
-                    );
+                    log_count(c.rejected, &format!("{why}: refused"));
                     return;
                 }
                 let Some(stepped) = judge(&mut self.wave_clock, c, "wave field", f.time_s, clock_s, &rules) else {
