@@ -22,6 +22,8 @@ Usage: python3 make_db.py --preset ship OUTDIR      (one 180 m ship)
        python3 make_db.py --preset pair OUTDIR      (180 m ship + 120 m ship side by side, 5 m gap)
        python3 make_db.py --preset barge OUTDIR     (one 24 m x 8 m x 3 m box barge)
        python3 make_db.py --preset box-test OUTDIR  (tiny, seconds: a smoke test of this script)
+       python3 make_db.py --preset offset-box OUTDIR   (the barge placed at x = 40 m; RAO at off-grid headings)
+       python3 make_db.py --preset messy-pair OUTDIR   (two 12 m boxes 6.5 m apart, no lid: B indefinite above 3 rad/s)
 """
 
 import argparse
@@ -70,7 +72,8 @@ def wigley_mesh(length, beam, draft, nx, nz, a2=0.6, a4=1.0, kappa=1.0):
     return cpt.Mesh.from_list_of_faces(np.array(faces), name="wigley")
 
 
-def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_m, radii, lid_placement="lowest"):
+def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_m, radii, lid_placement="lowest",
+              lid_omega=None):
     if hull == "wigley":
         nx = max(8, int(math.ceil(length / panel_m)))
         nz = max(3, int(math.ceil((draft + 0.5 * beam) / panel_m)))
@@ -95,17 +98,22 @@ def make_body(name, hull, length, beam, draft, position, panel_m, omega_max, kg_
     #   carrier alone, 2 m panels (session 11): the 1.76 rad/s spike is gone, and a lid only 5 % of the
     #   draft down still moved the smooth data well below it (heave damping at 1.6 rad/s 3.41e6 against
     #   5.20e6 with the lid on the surface; 2.48e7 both at 0.5 rad/s).
-    if lid_placement == "surface":
+    # - "none": no lid, so the irregular frequencies stay in the data (messy-pair: a deliberately bad database).
+    # `lid_omega` (a preset's `lid_omega`) is the frequency "lowest" places the lid for instead of omega_max
+    # (offset-box: the barge's lid, placed for the barge's 3 rad/s, on data that stop at 2.5 rad/s).
+    if lid_placement == "none":
+        z_lid = None
+    elif lid_placement == "surface":
         z_lid = 0.0
     elif lid_placement == "waterline":
         z_lid = -0.05 * draft
     elif lid_placement == "lowest":
-        z_lid = float(mesh.lowest_lid_position(1.25 * omega_max, g=G))
+        z_lid = float(mesh.lowest_lid_position(1.25 * (omega_max if lid_omega is None else lid_omega), g=G))
         if not math.isfinite(z_lid) or z_lid > -0.05 * draft:
             z_lid = -0.05 * draft
     else:
         raise ValueError(f"unknown lid placement {lid_placement}")
-    lid = mesh.generate_lid(z=z_lid, faces_max_radius=0.75 * panel_m)
+    lid = None if z_lid is None else mesh.generate_lid(z=z_lid, faces_max_radius=0.75 * panel_m)
     dofs = cpt.rigid_body_dofs(rotation_center=np.array(position, dtype=float))
     body = cpt.FloatingBody(mesh=mesh, lid_mesh=lid, dofs=dofs, name=name)
     volume = body.disp_volume
@@ -258,6 +266,65 @@ PRESETS["pair-direct"] = dict(PRESETS["pair"], bem_method="direct")
 PRESETS["pair-high-freq-gf"] = dict(PRESETS["pair"], gf_singularities="high_freq")
 
 
+# offset-box: the barge preset's hull, panels, mass properties and lid (placed for the barge's 3 rad/s via
+# lid_omega), but with its reference point at x = 40 m in the BEM frame, so its excitation, referred to the
+# global origin, turns by k 40 cos(beta) between headings; database headings 0-180 deg only (the hull is
+# symmetric port-starboard and on the x axis), and Capytaine's RAO also at off-grid headings (7.5-172.5 deg
+# every 15, and 187.5, 217.5, 262.5, 307.5, 352.5 deg in the other half, solved directly): the target of a
+# test of heading interpolation, half-circle symmetry and the phase reference of a body away from the origin.
+# Run (13 s, one thread; 384 hull + 147 lid panels, lid at z = -0.646 m as the barge's): 70 frequencies
+# 0.2-2.5 rad/s, 13 database headings, 30 solved (those of capytaine_rao.csv). Against the barge preset at
+# their common frequencies: A, B and C identical to the digits written, X the barge's times exp(-i k 40
+# cos beta) to 3.6e-6 of its peak, Capytaine's RAO likewise to 1.5e-8 (so the excitation is referred to the
+# global origin for a single body too); the RAO at 360 - beta mirrors beta's exactly (sway, roll, yaw with
+# their sign turned). Heave 4.89 s, pitch 4.49 s, roll 7.70 s (0.816 rad/s; the beam-sea roll RAO peaks at
+# 0.84 rad/s). B passive (lowest scaled eigenvalue -3e-4).
+PRESETS["offset-box"] = dict(
+    PRESETS["barge"],
+    stem="offset_box",
+    bodies=[dict(PRESETS["barge"]["bodies"][0], name="offset_box", position=(40.0, 0.0, 0.0))],
+    lid_omega=3.0,
+    # every 0.05 rad/s, 0.02 around roll (0.82 rad/s) and heave and pitch (1.28 and 1.40 rad/s)
+    omegas=np.unique(np.round(np.concatenate([np.arange(0.2, 0.7, 0.05), np.arange(0.7, 0.9601, 0.02),
+                                              np.arange(1.0, 1.1, 0.05), np.arange(1.1, 1.6001, 0.02),
+                                              np.arange(1.65, 2.5001, 0.05)]), 4)),
+    headings_deg=np.arange(0.0, 180.0001, 15.0),
+    rao_headings_deg=np.unique(np.concatenate([np.arange(0.0, 180.0001, 15.0), np.arange(7.5, 180.0, 15.0),
+                                               [187.5, 217.5, 262.5, 307.5, 352.5]])),
+)
+# messy-pair: two identical 12 m x 4 m x 2 m boxes side by side, 6.5 m between the hull sides, coupled, and
+# NO lid, so the irregular frequencies (the first of a 12 x 4 x 2 box at 2.96 rad/s: k = pi sqrt(1/L^2 +
+# 1/B^2), w^2 = g k coth(k T)) stay in the data above the 0.3-2.5 rad/s band that matters, with the
+# frequencies continued to 5 rad/s on panels too coarse there: a deliberately messy database (B(w)
+# indefinite above 3 rad/s) as close hulls often give, for the passivity repair and the fits downstream.
+# Run (65 s on two threads, 117 s beside a cargo build; 448 + 448 hull panels of 0.5 m, no lid; Capytaine
+# warns of the mesh above 4.675 rad/s): 175 frequencies 0.2-5 rad/s, 12 headings. B(w), symmetrized, in
+# coordinates scaled by sqrt(max_w B_ii) (as shipcast's passive_damping): indefinite (eigenvalue below
+# -1e-3) at 53 of the 85 frequencies from 2.925 to 5 rad/s, worst -1.32 at 3.1 rad/s (-6.4 % of the largest
+# |eigenvalue| unscaled), -0.52 at 2.95; the diagonal heave and pitch damping negative at 2.95-2.975,
+# 3.075-3.15, 3.325-3.35, 3.575-3.6, 3.85-3.9 and 4.325-4.425 rad/s (the box's irregular frequencies, 2.96,
+# 3.12, 3.34, 3.60 rad/s, ...). Over 0.3-2.9 rad/s the lowest scaled eigenvalue is -1.9e-4 (noise).
+# Asymmetry before symmetrizing: at most 1.35 % (A) and 5.9 % (B, at the gap's resonance) below 2.5 rad/s,
+# 118 % (B) at the irregular frequencies. Free-floating roll RAO (beam seas) peaks at 1.2 rad/s (C44 /
+# (M44 + A44) about the reference point: 1.003 rad/s, 6.26 s, where the 5 % roll damping is set); heave
+# 3.72 s, pitch 3.46 s; a sway-roll resonance of the gap at 2.315 rad/s (B22 seven times its value 0.1 rad/s
+# either side).
+PRESETS["messy-pair"] = dict(
+    stem="messy_pair",
+    bodies=[dict(name="box_a", hull="box", length=12.0, beam=4.0, draft=2.0, position=(0.0, 0.0, 0.0),
+                 kg_m=1.3, radii=(0.35 * 4, 0.25 * 12, 0.26 * 12), roll_damping_ratio=0.05),
+            dict(name="box_b", hull="box", length=12.0, beam=4.0, draft=2.0, position=(0.0, 10.5, 0.0),
+                 kg_m=1.3, radii=(0.35 * 4, 0.25 * 12, 0.26 * 12), roll_damping_ratio=0.05)],
+    panel_m=0.5,
+    lid="none",
+    # every 0.05 rad/s to 2.5, 0.02 around the roll RAO's peak (1.2 rad/s; C44 / (M44 + A44) about the
+    # reference point gives 1.0), 0.01 over the gap's sway-roll resonance (2.31 rad/s), 0.025 above 2.5 rad/s
+    # (the irregular frequencies' spikes are about 0.1 rad/s wide)
+    omegas=np.unique(np.round(np.concatenate([np.arange(0.2, 2.5, 0.05), np.arange(1.1, 1.3001, 0.02),
+                                              np.arange(2.2, 2.4501, 0.01), np.arange(2.5, 5.0001, 0.025)]), 4)),
+    headings_deg=np.arange(0.0, 360.0, 30.0),
+)
+
 
 def fmt(v):
     return f"{v:.7e}"
@@ -275,14 +342,16 @@ def main():
     omegas = np.asarray(p["omegas"], dtype=float)
     omega_max = float(omegas.max())
     built = [make_body(b["name"], b["hull"], b["length"], b["beam"], b["draft"], b["position"], p["panel_m"],
-                       omega_max, b["kg_m"], b["radii"], p.get("lid", "lowest")) for b in p["bodies"]]
+                       omega_max, b["kg_m"], b["radii"], p.get("lid", "lowest"), p.get("lid_omega"))
+             for b in p["bodies"]]
     bodies = [b[0] for b in built]
     for (body, mass, cog, z_lid), spec in zip(built, p["bodies"]):
         m = mass_matrix(mass, cog - np.array(spec["position"]), spec["radii"])
         body.inertia_matrix = body.add_dofs_labels_to_matrix(m)
         body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness(rho=RHO, g=G)
-        print(f"{body.name}: {body.mesh.nb_faces} hull panels, {body.lid_mesh.nb_faces} lid panels at "
-              f"z = {z_lid:.2f} m, mass {mass:.4e} kg, CoG {cog}", flush=True)
+        lid_text = "no lid" if z_lid is None else f"{body.lid_mesh.nb_faces} lid panels at z = {z_lid:.2f} m"
+        print(f"{body.name}: {body.mesh.nb_faces} hull panels, {lid_text}, mass {mass:.4e} kg, CoG {cog}",
+              flush=True)
     system = bodies[0] if len(bodies) == 1 else cpt.Multibody(bodies)
     dof_names = list(system.dofs.keys())
     nmodes = len(dof_names)
@@ -292,7 +361,14 @@ def main():
     gf_singularities = p.get("gf_singularities", "low_freq")
     solver = cpt.BEMSolver(green_function=cpt.Delhommeau(gf_singularities=gf_singularities), method=bem_method)
 
-    headings_rad = np.radians(p["headings_deg"])
+    # The database's headings (the .3 file) and the headings of Capytaine's RAO (capytaine_rao.csv; a preset's
+    # `rao_headings_deg`, by default the database's): the diffraction problems are solved at both.
+    db_headings = np.asarray(p["headings_deg"], dtype=float)
+    rao_headings = np.asarray(p.get("rao_headings_deg", db_headings), dtype=float)
+    solved_headings = np.unique(np.round(np.concatenate([db_headings, rao_headings]), 9))
+    db_index = [int(np.argmin(np.abs(solved_headings - h))) for h in db_headings]
+    rao_index = [int(np.argmin(np.abs(solved_headings - h))) for h in rao_headings]
+    headings_rad = np.radians(solved_headings)
     test = xr.Dataset(coords={"omega": omegas, "wave_direction": headings_rad,
                               "radiating_dof": dof_names, "water_depth": [np.inf], "rho": [RHO], "g": [G]})
     ds = solver.fill_dataset(test, system, progress_bar=False)
@@ -373,7 +449,7 @@ def main():
         exc = ds["excitation_force"].transpose("omega", "wave_direction", "influenced_dof")
         for io_, omega in enumerate(omegas):
             per = 2 * np.pi / omega
-            for ib, beta in enumerate(p["headings_deg"]):
+            for ib, beta in zip(db_index, db_headings):
                 for i in range(nmodes):
                     x = np.conj(complex(exc.values[io_, ib, i])) / (RHO * G)
                     f.write(f"{fmt(per)} {fmt(beta)} {i + 1:3d} {fmt(abs(x))} {fmt(np.degrees(np.angle(x)))} "
@@ -388,7 +464,7 @@ def main():
         f.write("omega,heading_deg,mode,amplitude,phase_deg\n")
         r = rao.transpose("omega", "wave_direction", "radiating_dof").values
         for io_, omega in enumerate(omegas):
-            for ib, beta in enumerate(p["headings_deg"]):
+            for ib, beta in zip(rao_index, rao_headings):
                 for i in range(nmodes):
                     x = np.conj(complex(r[io_, ib, i]))
                     f.write(f"{omega:.6g},{beta:.6g},{i + 1},{abs(x):.9e},{np.degrees(np.angle(x)):.6f}\n")
@@ -417,18 +493,66 @@ def main():
             f.write(f'\n[[point]]\nname = "{name}"\nbody = "{body}"\nposition_m = [{at[0]}, {at[1]}, {at[2]}]\n')
         for name, a, b in p.get("relative_motions", []):
             f.write(f'\n[[relative_motion]]\nname = "{name}"\npoint_a = "{a}"\npoint_b = "{b}"\n')
+    # Passivity of the (symmetrized) damping: the smallest eigenvalue of B(w), raw (relative to the largest
+    # |eigenvalue| at that frequency) and in coordinates scaled by sqrt(max_w B_ii) as shipcast's
+    # hydro::radiation::passive_damping does (translations and rotations weigh alike).
+    bmat = np.asarray(ds["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof").values)
+    peaks = np.array([np.abs(bmat[:, i, i]).max() for i in range(nmodes)])
+    sc = np.sqrt(np.where(peaks > 1e-9 * peaks.max(), peaks, np.inf))
+    indefinite, lowest_scaled, lowest_at = [], 0.0, None
+    for io_, omega in enumerate(omegas):
+        bs = 0.5 * (bmat[io_] + bmat[io_].T)
+        raw = np.linalg.eigvalsh(bs)
+        scaled = np.linalg.eigvalsh(bs / np.outer(sc, sc))
+        if scaled.min() < -1e-3:
+            indefinite.append(float(omega))
+            print(f"B indefinite at omega = {omega:.4g}: min eigenvalue {raw.min() / np.abs(raw).max():+.4f} of the "
+                  f"largest |eigenvalue|, scaled {scaled.min():+.4f}", flush=True)
+        if scaled.min() < lowest_scaled:
+            lowest_scaled, lowest_at = float(scaled.min()), float(omega)
+    # natural periods of heave, roll and pitch: the lowest frequency in the data with C_ii = w^2 (M_ii + A_ii(w))
+    natural = []
+    for k in range(len(bodies)):
+        periods = {}
+        for j, name in ((2, "heave"), (3, "roll"), (4, "pitch")):
+            i = 6 * k + j
+            am = np.asarray(ds["added_mass"].sel(radiating_dof=dof_names[i], influenced_dof=dof_names[i]).values)
+            res = cmat[i, i] - omegas**2 * (mmat[i, i] + am)
+            cross = np.nonzero((res[:-1] > 0) & (res[1:] <= 0))[0]
+            if len(cross) == 0:
+                periods[name] = None
+                continue
+            n = cross[0]
+            w = omegas[n] + (omegas[n + 1] - omegas[n]) * res[n] / (res[n] - res[n + 1])
+            periods[name] = float(2 * np.pi / w)
+            print(f"{bodies[k].name}: {name} natural period {2 * np.pi / w:.3f} s ({w:.4f} rad/s)", flush=True)
+        natural.append(periods)
     with open(os.path.join(args.outdir, "bem_info.toml"), "w") as f:
         f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
+        f.write(f'command = "python3 tools/bem/make_db.py --preset {args.preset} {args.outdir}"\n')
         f.write(f"solve_seconds = {t_solve:.1f}\n")
         f.write(f'bem_method = "{bem_method}"\ngf_singularities = "{gf_singularities}"\n')
         for key, worst in asym.items():
             f.write(f"asymmetry_{key} = {worst:.6f}   # largest |X_ij - X_ji| / sqrt(X_ii X_jj) before symmetrizing\n")
         f.write(f"n_omega = {len(omegas)}\nomega_min = {omegas.min()}\nomega_max = {omega_max}\n")
-        f.write(f"headings_deg = {list(map(float, p['headings_deg']))}\n")
-        for body in bodies:
-            f.write(f'[panels.{body.name}]\nhull = {body.mesh.nb_faces}\nlid = {body.lid_mesh.nb_faces}\n')
-    print(f"done in {time.time() - t0:.1f} s: {len(omegas)} frequencies, {len(p['headings_deg'])} headings, "
-          f"{nmodes} modes", flush=True)
+        f.write(f"headings_deg = {list(map(float, db_headings))}\n")
+        f.write(f"rao_headings_deg = {list(map(float, rao_headings))}   # the headings of capytaine_rao.csv\n")
+        f.write(f'lid = "{p.get("lid", "lowest")}"\n')
+        f.write(f"damping_indefinite_omegas = {[float(w) for w in indefinite]}   # symmetric B(w), scaled: "
+                f"an eigenvalue below -1e-3\n")
+        f.write(f"damping_lowest_scaled_eigenvalue = {lowest_scaled:.6f}"
+                + ("\n" if lowest_at is None else f"   # at omega = {lowest_at}\n"))
+        for body, _, _, z_lid in built:
+            n_lid = 0 if z_lid is None else body.lid_mesh.nb_faces
+            f.write(f'[panels.{body.name}]\nhull = {body.mesh.nb_faces}\nlid = {n_lid}\n')
+            if z_lid is not None:
+                f.write(f"lid_z = {z_lid:.6f}\n")
+        for body, periods in zip(bodies, natural):
+            f.write(f"[natural_periods_s.{body.name}]   # C_ii = w^2 (M_ii + A_ii(w)), lowest root in the data\n")
+            for name, t in periods.items():
+                f.write(f"{name} = {'nan' if t is None else f'{t:.4f}'}\n")
+    print(f"done in {time.time() - t0:.1f} s: {len(omegas)} frequencies, {len(db_headings)} database headings "
+          f"({len(solved_headings)} solved), {nmodes} modes", flush=True)
     # diagonal damping must be non-negative (irregular frequencies, coarse panels)
     bd = ds["radiation_damping"]
     for k, name in enumerate(dof_names):
