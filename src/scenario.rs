@@ -266,6 +266,7 @@ impl Prepared {
             waves: &self.waves,
             length_s,
             ramp_s: 0.0,
+            drift_velocity: None,
         }
     }
 }
@@ -308,6 +309,7 @@ pub fn prepare(past: &TimeModel, model: &TimeModel, waves: &Waves, history_s: f6
             waves: &waves,
             length_s: history_s,
             ramp_s: 30.0_f64.min(history_s / 2.0),
+            drift_velocity: None,
         },
     )?;
     let mut memory = Memory::new(model);

@@ -625,7 +625,9 @@ fn a_version_1_log_still_replays_to_the_same_forecasts() {
             })
             .collect()
     };
-    // the forecasts today's shipcast replays from it are those the version-1 shipcast replayed
+    // the forecasts today's shipcast replays from it are those in forecasts.mcap, bit for bit (remade
+    // with `shipcast replay sim.mcap --config shipcast.toml --out forecasts.mcap` only when the model
+    // changes on purpose: last for the excitation's cubic heading interpolation and the drift estimate)
     let (was, now) = (forecasts(&repo("tests/data/replay-v1/forecasts.mcap")), forecasts(&out));
     assert!(was.len() > 20, "{}", was.len());
     assert_eq!(was.len(), now.len());

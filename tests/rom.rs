@@ -326,6 +326,7 @@ fn run_from_rest_history(
             waves,
             length_s,
             ramp_s,
+            drift_velocity: None,
         },
     )
     .cloned()

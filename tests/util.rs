@@ -41,6 +41,52 @@ impl RaoRow {
 }
 
 /// Parses an RAO CSV, checking its header.
+/// Curves below this fraction of their mode's largest peak (sway in head seas) are judged against that
+/// largest peak, as in `rom::floor`.
+const SMALL_CURVE: f64 = 0.1;
+
+/// (mode, heading in mdeg, omega in micro rad/s) of a row.
+fn rao_key(r: &RaoRow) -> (usize, i64, i64) {
+    (
+        r.mode,
+        (r.heading_deg * 1000.0).round() as i64,
+        (r.omega * 1e6).round() as i64,
+    )
+}
+
+/// Worst |test - reference| over the rows of the reference with omega in `band`, relative to the peak of
+/// its (mode, heading) curve over the whole reference (small curves to their mode's largest), with where.
+pub fn rao_worst(test: &[RaoRow], reference: &[RaoRow], band: std::ops::RangeInclusive<f64>) -> (f64, String) {
+    use std::collections::HashMap;
+    let test: HashMap<_, _> = test.iter().map(|r| (rao_key(r), *r)).collect();
+    let mut curve_peak: HashMap<(usize, i64), f64> = HashMap::new();
+    let mut mode_peak: HashMap<usize, f64> = HashMap::new();
+    for r in reference {
+        let (m, h, _) = rao_key(r);
+        let p = curve_peak.entry((m, h)).or_default();
+        *p = p.max(r.amplitude);
+        let q = mode_peak.entry(m).or_default();
+        *q = q.max(r.amplitude);
+    }
+    let mut out = (0.0, String::new());
+    for r in reference.iter().filter(|r| band.contains(&r.omega)) {
+        let (m, h, _) = rao_key(r);
+        let t = test.get(&rao_key(r)).unwrap_or_else(|| panic!("no row for {r:?}"));
+        let peak = curve_peak[&(m, h)];
+        let scale = if peak >= SMALL_CURVE * mode_peak[&m] {
+            peak
+        } else {
+            mode_peak[&m]
+        };
+        let ((ar, ai), (br, bi)) = (t.complex(), r.complex());
+        let e = (ar - br).hypot(ai - bi) / scale;
+        if e > out.0 {
+            out = (e, format!("mode {m}, heading {} deg, {} rad/s", r.heading_deg, r.omega));
+        }
+    }
+    out
+}
+
 pub fn parse_rao_csv(text: &str) -> Vec<RaoRow> {
     let mut lines = text.lines();
     assert_eq!(

@@ -119,6 +119,7 @@ fn forces_sample_by_sample_match_wecsim() {
         waves: &waves,
         length_s: DURATION_S,
         ramp_s: RAMP_S,
+        drift_velocity: None,
     };
     let force = Forecaster::new().force_for(&m, &req).unwrap();
     let n = m.n();

@@ -1,13 +1,25 @@
 //! The hydrodynamic database in SI units, and its interpolation over frequency and heading.
 //!
-//! Interpolation is linear in w for A and B, and bilinear in (w, beta) on the real and imaginary parts of X
-//! (never on amplitude and phase, which wrap and misbehave near zeros). Headings that cover the circle
-//! (the gap across 360 deg no larger than the largest gap between stored headings) interpolate across
-//! 360 deg; otherwise a heading outside the stored range is an error, as is a frequency outside
-//! [w_min, w_max]: the database is never extrapolated.
+//! Interpolation is linear in w for A and B. X is interpolated on its real and imaginary parts (never on
+//! amplitude and phase, which wrap and misbehave near zeros), referred first to each body's own reference
+//! point ([`HydroDb::set_bodies`]): a multi-body database refers every body's excitation to the global
+//! origin, where a body at r_b turns it by exp(-i k r_b . e_beta) between stored headings (k r_b = 40 rad
+//! for a body 40 m out at 2.5 rad/s); referred to the body the values vary with heading as the hull does.
+//! Linear in w, cubic in beta (Lagrange through the two stored headings either side, or the nearest four
+//! inside the range at its ends), then turned back to the global origin at the query's k and heading.
+//! Headings that cover the circle (the gap across 360 deg no larger than the largest gap between stored
+//! headings) interpolate across 360 deg. A database over 0-180 deg only (or 180-360) of a system whose
+//! bodies all lie on its x axis is completed by port-starboard symmetry: X at -beta is X at beta with
+//! sway, roll and yaw negated (system file `port_starboard_symmetric`, default: when that holds). A
+//! heading outside what is stored (or mirrored) is an error, as is a frequency outside [w_min, w_max]: the
+//! database is never extrapolated.
+//!
+//! Conventions: exp(+i w t); a wave eta = Re{a exp(i(w t - k (x cos b + y sin b)))}, b the direction the
+//! waves travel to, counterclockwise from +x (DESIGN.md section 1).
 
 use super::wamit::{Excitation, Radiation};
 use super::{Error, Result};
+use crate::waves::wave_number;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
@@ -29,6 +41,15 @@ pub struct HydroDb {
     pub excitation: Vec<Complex64>,
     /// Linear restoring C, 6N x 6N.
     pub restoring: DMatrix<f64>,
+    /// X referred to each body's reference point, same layout as `excitation` ([`Self::set_bodies`]).
+    referred: Vec<Complex64>,
+    /// Each body's reference point (x, y) in the database's frame, m (empty: all at the origin).
+    body_origin_m: Vec<[f64; 2]>,
+    /// For the wave number of the referral: g, m/s^2, and the depth (None: deep water), m.
+    g_m_s2: f64,
+    depth_m: Option<f64>,
+    /// The headings of (pi, 2 pi) (or (0, pi)) were made by port-starboard symmetry.
+    pub mirrored: bool,
 }
 
 /// Index of the segment holding `x` in ascending `xs` and the weight of its right end.
@@ -45,7 +66,8 @@ pub(crate) fn bracket(xs: &[f64], x: f64) -> Option<(usize, f64)> {
     Some((i, w.clamp(0.0, 1.0)))
 }
 
-const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+const PI: f64 = std::f64::consts::PI;
+const TWO_PI: f64 = 2.0 * PI;
 
 impl HydroDb {
     /// Assembles the database from the WAMIT readers' output. `file` labels errors.
@@ -90,9 +112,113 @@ impl HydroDb {
             added_mass_zero: rad.added_mass_zero,
             exc_omega_rad_s: exc.omega_rad_s,
             heading_rad,
+            referred: excitation.clone(),
             excitation,
             restoring,
+            body_origin_m: vec![],
+            g_m_s2: 9.81,
+            depth_m: None,
+            mirrored: false,
         })
+    }
+
+    /// Refers the excitation to each body's reference point (`origins_m`, x and y in the database's
+    /// frame, one per body; g and depth for the wave number), and completes a half circle of headings by
+    /// port-starboard symmetry where `mirror` says so (None: when every body lies on the x axis and the
+    /// stored headings are within 0-180 or 180-360 deg, and do not cover the circle). Err: `mirror =
+    /// Some(true)` where the symmetry cannot hold.
+    pub fn set_bodies(
+        &mut self,
+        origins_m: &[[f64; 2]],
+        g_m_s2: f64,
+        depth_m: Option<f64>,
+        mirror: Option<bool>,
+    ) -> std::result::Result<(), String> {
+        if origins_m.len() * 6 != self.n_modes {
+            // the system's own check names that mismatch; nothing is referred
+            return Ok(());
+        }
+        self.body_origin_m = origins_m.to_vec();
+        self.g_m_s2 = g_m_s2;
+        self.depth_m = depth_m;
+        let (n, nb) = (self.n_modes, self.heading_rad.len());
+        for (iw, &w) in self.exc_omega_rad_s.iter().enumerate() {
+            let k = wave_number(w, g_m_s2, depth_m);
+            for (ib, &b) in self.heading_rad.iter().enumerate() {
+                for i in 0..n {
+                    let at = (iw * nb + ib) * n + i;
+                    self.referred[at] = self.excitation[at] * self.turn(i, k, b).conj();
+                }
+            }
+        }
+        let on_axis = origins_m.iter().all(|o| o[1].abs() <= 1e-6);
+        let h = &self.heading_rad;
+        let eps = 1e-9;
+        let half = (h.iter().all(|&b| b <= PI + eps) || h.iter().all(|&b| b >= PI - eps || b <= eps))
+            && !self.headings_cover_circle();
+        match mirror {
+            Some(true) if !on_axis => {
+                return Err("port-starboard symmetry needs every body on the x axis (position y = 0)".into());
+            }
+            Some(true) if !half => {
+                return Err(
+                    "port-starboard symmetry needs the database's headings within 0-180 (or 180-360) deg, not covering the circle"
+                        .into(),
+                );
+            }
+            Some(false) => return Ok(()),
+            _ if !(on_axis && half) => return Ok(()),
+            _ => {}
+        }
+        self.mirror();
+        Ok(())
+    }
+
+    /// exp(-i k r_b . e_beta) of the body owning mode `i`: the wave phase at its reference point.
+    fn turn(&self, i: usize, k: f64, heading_rad: f64) -> Complex64 {
+        match self.body_origin_m.get(i / 6) {
+            Some(o) => {
+                let (s, c) = heading_rad.sin_cos();
+                Complex64::from_polar(1.0, -k * (o[0] * c + o[1] * s))
+            }
+            None => Complex64::new(1.0, 0.0),
+        }
+    }
+
+    /// Adds the mirror image -beta of every stored heading strictly between 0 and pi (or pi and 2 pi),
+    /// with sway, roll and yaw negated.
+    fn mirror(&mut self) {
+        let (n, nb) = (self.n_modes, self.heading_rad.len());
+        let eps = 1e-9;
+        let mut all: Vec<(f64, usize, bool)> = self
+            .heading_rad
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| (b, i, false))
+            .collect();
+        for (i, &b) in self.heading_rad.iter().enumerate() {
+            if b > eps && (b - PI).abs() > eps {
+                all.push(((TWO_PI - b).rem_euclid(TWO_PI), i, true));
+            }
+        }
+        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let sign = |i: usize| if matches!(i % 6, 1 | 3 | 5) { -1.0 } else { 1.0 };
+        let pick = |src: &[Complex64]| {
+            let mut out = Vec::with_capacity(self.exc_omega_rad_s.len() * all.len() * n);
+            for iw in 0..self.exc_omega_rad_s.len() {
+                for &(_, ib, mirrored) in &all {
+                    out.extend((0..n).map(|i| {
+                        let v = src[(iw * nb + ib) * n + i];
+                        if mirrored { v * sign(i) } else { v }
+                    }));
+                }
+            }
+            out
+        };
+        self.excitation = pick(&self.excitation);
+        self.referred = pick(&self.referred);
+        self.heading_rad = all.iter().map(|a| a.0).collect();
+        self.mirrored = true;
     }
 
     /// Zeroes every 6x6 block coupling two different bodies (`hydrodynamic_coupling = false`).
@@ -149,36 +275,68 @@ impl HydroDb {
         TWO_PI - h[h.len() - 1] + h[0] <= max_gap + 1e-9
     }
 
-    /// The two stored headings around `heading_rad` and the weight of the second.
-    fn heading_bracket(&self, heading_rad: f64) -> Result<(usize, usize, f64)> {
+    /// The stored headings a heading is interpolated from and their weights: the Lagrange cubic through
+    /// the two either side and one beyond each (wrapping where the headings cover the circle; the nearest
+    /// four inside the range at its ends; fewer where fewer are stored). Unused slots have weight 0.
+    fn heading_stencil(&self, heading_rad: f64) -> Result<([usize; 4], [f64; 4])> {
         let h = &self.heading_rad;
+        let nb = h.len();
         let b = heading_rad.rem_euclid(TWO_PI);
         let near = |x: f64, y: f64| {
             let d = (x - y).rem_euclid(TWO_PI);
             d.min(TWO_PI - d) < 1e-9
         };
         if let Some(i) = h.iter().position(|&x| near(x, b)) {
-            return Ok((i, i, 0.0));
+            return Ok(([i, i, i, i], [1.0, 0.0, 0.0, 0.0]));
         }
-        if let Some((i, w)) = bracket(h, b) {
-            return Ok((i, (i + 1).min(h.len() - 1), w));
+        let circle = self.headings_cover_circle();
+        // the segment [lo, lo + 1] (indices, possibly past the end on a circle) holding b, unwrapped
+        let (lo, b) = if let Some((i, _)) = bracket(h, b) {
+            (i as isize, b)
+        } else if circle {
+            let last = nb - 1;
+            (last as isize, if b < h[0] { b + TWO_PI } else { b })
+        } else {
+            return Err(self.outside(heading_rad));
+        };
+        // unwrapped angle of index j (any integer on a circle)
+        let angle = |j: isize| {
+            let m = j.rem_euclid(nb as isize) as usize;
+            h[m] + TWO_PI * j.div_euclid(nb as isize) as f64
+        };
+        let count = nb.min(4) as isize;
+        let mut first = lo - (count - 1) / 2;
+        if !circle {
+            first = first.clamp(0, nb as isize - count);
         }
-        if self.headings_cover_circle() {
-            let last = h.len() - 1;
-            let span = TWO_PI - h[last] + h[0];
-            let d = (b - h[last]).rem_euclid(TWO_PI);
-            return Ok((last, 0, d / span));
+        let (mut idx, mut wts) = ([0usize; 4], [0.0; 4]);
+        for a in 0..count {
+            let ja = first + a;
+            let mut w = 1.0;
+            for c in 0..count {
+                if c != a {
+                    let jc = first + c;
+                    w *= (b - angle(jc)) / (angle(ja) - angle(jc));
+                }
+            }
+            idx[a as usize] = ja.rem_euclid(nb as isize) as usize;
+            wts[a as usize] = w;
         }
-        Err(Error::OutOfRange(format!(
+        Ok((idx, wts))
+    }
+
+    fn outside(&self, heading_rad: f64) -> Error {
+        let h = &self.heading_rad;
+        Error::OutOfRange(format!(
             "heading {:.3} deg is outside the database's headings {:?} deg",
             heading_rad.to_degrees(),
             h.iter()
                 .map(|x| (x.to_degrees() * 1e6).round() / 1e6)
                 .collect::<Vec<_>>()
-        )))
+        ))
     }
 
-    /// X(w, beta), bilinear in (w, beta) on real and imaginary parts.
+    /// X(w, beta): linear in w, cubic in beta, on the values referred to each body (module docs).
     pub fn excitation_at(&self, omega_rad_s: f64, heading_rad: f64) -> Result<DVector<Complex64>> {
         let mut out = DVector::from_element(self.n_modes, Complex64::default());
         self.excitation_into(omega_rad_s, heading_rad, out.as_mut_slice())?;
@@ -196,13 +354,19 @@ impl HydroDb {
             ))
         })?;
         let jw = (iw + 1).min(ws.len() - 1);
-        let (ib, jb, wb) = self.heading_bracket(heading_rad)?;
+        let (idx, wts) = self.heading_stencil(heading_rad)?;
         let n = self.n_modes;
         let nb = self.heading_rad.len();
-        let at = |w: usize, b: usize, i: usize| self.excitation[(w * nb + b) * n + i];
+        let k = wave_number(omega_rad_s, self.g_m_s2, self.depth_m);
+        let at = |w: usize, i: usize| -> Complex64 {
+            idx.iter()
+                .zip(&wts)
+                .filter(|(_, w)| **w != 0.0)
+                .map(|(&b, &wt)| self.referred[(w * nb + b) * n + i] * wt)
+                .sum()
+        };
         for (i, o) in out.iter_mut().enumerate().take(n) {
-            *o = (at(iw, ib, i) * (1.0 - wb) + at(iw, jb, i) * wb) * (1.0 - ww)
-                + (at(jw, ib, i) * (1.0 - wb) + at(jw, jb, i) * wb) * ww;
+            *o = (at(iw, i) * (1.0 - ww) + at(jw, i) * ww) * self.turn(i, k, heading_rad);
         }
         Ok(())
     }
@@ -250,16 +414,119 @@ mod tests {
         assert!(d.radiation_at(f64::NAN).is_err());
     }
 
+    /// A database of `headings_deg` at w = 0.5, 1.0 whose X is `f(heading_rad, w, mode)`.
+    fn db_of(headings_deg: &[f64], f: impl Fn(f64, f64, usize) -> Complex64) -> HydroDb {
+        let mut d = db(headings_deg.to_vec());
+        let nb = d.heading_rad.len();
+        for (iw, w) in [0.5, 1.0].into_iter().enumerate() {
+            for ib in 0..nb {
+                for i in 0..6 {
+                    d.excitation[(iw * nb + ib) * 6 + i] = f(d.heading_rad[ib], w, i);
+                }
+            }
+        }
+        d.referred = d.excitation.clone();
+        d
+    }
+
     #[test]
     fn headings_wrap_when_they_cover_the_circle() {
         let d = db(vec![-90.0, 0.0, 90.0, 180.0]); // -90 is stored as 270
         assert!(d.headings_cover_circle());
-        let x = d.excitation_at(0.5, 315f64.to_radians()).unwrap();
-        // halfway between 270 (value -90) and 0 (value 0)
-        assert!((x[0].re - (-45.0)).abs() < 1e-9, "{}", x[0]);
-        let x = d.excitation_at(0.75, 45f64.to_radians()).unwrap();
-        assert!((x[0].re - (45.0 + 500.0)).abs() < 1e-9, "{}", x[0]);
-        assert!((x[3].im - 3.0).abs() < 1e-12);
+        let hs: Vec<f64> = (0..12).map(|k| 30.0 * k as f64).collect();
+        let d = db_of(&hs, |b, _, _| Complex64::new(b.cos(), b.sin()));
+        // the cubic through 30 deg steps: its error on cos and sin is h^4 max|f(4)| / 24 (9/16), 2e-3
+        for q in [45.0f64, 345.0, 5.0, 359.0] {
+            let x = d.excitation_at(0.5, q.to_radians()).unwrap();
+            let want = Complex64::from_polar(1.0, q.to_radians());
+            assert!((x[0] - want).norm() < 3e-3, "{q}: {} vs {want}", x[0]);
+        }
+    }
+
+    #[test]
+    fn the_cubic_is_exact_on_cubics_to_the_ends_of_a_partial_range() {
+        let p = |b: f64| 1.0 + 2.0 * b - 0.5 * b * b + 0.3 * b * b * b;
+        let hs = [0.0, 20.0, 45.0, 60.0, 90.0, 130.0, 150.0, 180.0];
+        let d = db_of(&hs, |b, w, i| Complex64::new(p(b) * w, i as f64));
+        for q in [1.0f64, 10.0, 50.0, 100.0, 170.0, 179.5] {
+            let b = q.to_radians();
+            let x = d.excitation_at(0.75, b).unwrap();
+            assert!((x[0].re - 0.75 * p(b)).abs() < 1e-9, "{q}: {}", x[0]);
+            assert!((x[4].im - 4.0).abs() < 1e-9);
+        }
+        assert!(
+            d.excitation_at(0.75, 181f64.to_radians()).is_err(),
+            "never extrapolated"
+        );
+    }
+
+    #[test]
+    fn excitation_of_a_body_away_from_the_origin_is_interpolated_referred_to_it() {
+        // a body at (40, 10) m whose own excitation is the same at every heading: referred to the
+        // origin it turns by k r . e_beta, 2 rad between stored headings 30 deg apart near beam seas
+        // at 1 rad/s
+        let (g, r) = (9.81, [40.0, 10.0]);
+        let global = |b: f64, w: f64| {
+            let k = w * w / g;
+            Complex64::from_polar(1.0, -k * (r[0] * b.cos() + r[1] * b.sin()))
+        };
+        let hs: Vec<f64> = (0..12).map(|k| 30.0 * k as f64).collect();
+        let mut d = db_of(&hs, |b, w, _| global(b, w));
+        d.set_bodies(&[r], g, None, None).unwrap();
+        assert!(!d.mirrored, "a body off the x axis");
+        for q in [15.0f64, 100.0, 250.0] {
+            let b = q.to_radians();
+            // at a stored frequency: exact (the referred values are constant)
+            let x = d.excitation_at(1.0, b).unwrap();
+            assert!(
+                (x[2] - global(b, 1.0)).norm() < 1e-9,
+                "{q}: {} vs {}",
+                x[2],
+                global(b, 1.0)
+            );
+        }
+        // unreferred, the same interpolation is off by far more
+        let mut raw = db_of(&hs, |b, w, _| global(b, w));
+        raw.set_bodies(&[[0.0, 0.0]], g, None, None).unwrap();
+        let b = 105f64.to_radians();
+        let off = (raw.excitation_at(1.0, b).unwrap()[2] - global(b, 1.0)).norm();
+        assert!(off > 0.05, "{off}");
+    }
+
+    #[test]
+    fn a_half_circle_is_completed_by_port_starboard_symmetry() {
+        let hs: Vec<f64> = (0..=12).map(|k| 15.0 * k as f64).collect();
+        // a symmetric hull's sway, roll and yaw vanish in head and following seas
+        let f = |b: f64, _: f64, i: usize| match i {
+            1 | 3 | 5 => Complex64::new(b.sin(), 2.0 * b.sin() * (1 + i) as f64),
+            _ => Complex64::new(b.cos() + i as f64, (2.0 * b).cos()),
+        };
+        let mut d = db_of(&hs, f);
+        d.set_bodies(&[[40.0, 0.0]], 9.81, None, None).unwrap();
+        assert!(d.mirrored && d.headings_cover_circle());
+        assert_eq!(d.heading_rad.len(), 24);
+        for q in [200.0f64, 300.0, 352.5] {
+            let (x, m) = (
+                d.excitation_at(1.0, q.to_radians()).unwrap(),
+                d.excitation_at(1.0, (360.0 - q).to_radians()).unwrap(),
+            );
+            for i in 0..6 {
+                let s = if matches!(i, 1 | 3 | 5) { -1.0 } else { 1.0 };
+                assert!((x[i] - m[i] * s).norm() < 1e-9, "{q} mode {i}: {} vs {}", x[i], m[i]);
+            }
+        }
+        // not for a body off the axis, nor when the file says no; refused when it insists
+        let mut off = db_of(&hs, f);
+        off.set_bodies(&[[40.0, 3.0]], 9.81, None, None).unwrap();
+        assert!(!off.mirrored && off.excitation_at(1.0, 4.0).is_err());
+        let mut no = db_of(&hs, f);
+        no.set_bodies(&[[40.0, 0.0]], 9.81, None, Some(false)).unwrap();
+        assert!(!no.mirrored);
+        assert!(
+            db_of(&hs, f)
+                .set_bodies(&[[40.0, 3.0]], 9.81, None, Some(true))
+                .is_err()
+        );
     }
 
     #[test]

@@ -57,6 +57,9 @@ struct SystemFile {
     water_depth: DepthSpec,
     #[serde(default = "yes")]
     hydrodynamic_coupling: bool,
+    /// Complete a 0-180 deg database by port-starboard symmetry (default: when every body is on the x
+    /// axis; see [`super::db`]).
+    port_starboard_symmetric: Option<bool>,
     a_inf: Option<AInfSource>,
     irf: Option<IrfFile>,
     /// System-level linear damping entries `[mode_i, mode_j, value]`, WAMIT mode numbers 1..6N.
@@ -170,6 +173,8 @@ pub struct SystemSpec {
     /// None = infinite depth.
     pub water_depth_m: Option<f64>,
     pub hydrodynamic_coupling: bool,
+    /// `port_starboard_symmetric` (None: decided by the geometry, [`HydroDb::set_bodies`]).
+    pub port_starboard_symmetric: Option<bool>,
     pub a_inf: Option<AInfSource>,
     pub irf: IrfOptions,
     pub bodies: Vec<Body>,
@@ -288,6 +293,7 @@ impl SystemSpec {
             g_m_s2: raw.g,
             water_depth_m,
             hydrodynamic_coupling: raw.hydrodynamic_coupling,
+            port_starboard_symmetric: raw.port_starboard_symmetric,
             a_inf: raw.a_inf,
             irf,
             bodies,
@@ -495,6 +501,13 @@ impl VesselSystem {
         if !spec.hydrodynamic_coupling {
             db.decouple();
         }
+        let origins: Vec<[f64; 2]> = spec.bodies.iter().map(|b| [b.position_m.x, b.position_m.y]).collect();
+        db.set_bodies(&origins, spec.g_m_s2, spec.water_depth_m, spec.port_starboard_symmetric)
+            .map_err(|msg| Error::Key {
+                file: file.into(),
+                key: "port_starboard_symmetric".into(),
+                msg,
+            })?;
         if spec.a_inf == Some(AInfSource::Database) && db.added_mass_inf.is_none() {
             return Err(Error::Invalid {
                 file: file.into(),

@@ -26,7 +26,7 @@ pub fn drive(
     crate::service::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
-    let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg.forecast.horizon_s);
+    let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg);
     let period = cfg.forecast.period_s;
     // ticks on the grid t0 + k period; past this long after the last input no tick can issue a forecast
     // (the motion is stale), so a gap in the log is crossed in one step, not a tick per period

@@ -35,6 +35,10 @@ pub struct ForecastRequest<'a> {
     pub length_s: f64,
     /// Optional ramp of the wave force over its first seconds (regular-wave runs), s; 0 = none.
     pub ramp_s: f64,
+    /// The slow drift velocity measured before t0 ([`super::drift::slow_velocity`]): the mean velocity
+    /// of the modes without restoring over the forecast is set to it ([`super::drift::apply`]). None:
+    /// the forecast runs from `v0` as it is.
+    pub drift_velocity: Option<&'a [f64]>,
 }
 
 /// A forecast: every state (6N body modes then the tanks; inactive ones zero) on t = t0 + k dt,
@@ -227,6 +231,23 @@ impl Forecaster {
                 self.out.a[k * nm + i] = self.stepper.a[r];
             }
         }
+        if let Some(vd) = req.drift_velocity {
+            if vd.len() != n {
+                return Err(Error::Input(format!(
+                    "drift velocity has {} values, the model {n} active states",
+                    vd.len()
+                )));
+            }
+            super::drift::apply(
+                &model.drift_modes,
+                vd,
+                &model.active,
+                nm,
+                dt,
+                &mut self.out.x,
+                &mut self.out.v,
+            );
+        }
         Ok(&self.out)
     }
 
@@ -247,6 +268,7 @@ impl Forecaster {
             waves,
             length_s,
             ramp_s,
+            drift_velocity: None,
         };
         self.forecast(model, &req)
     }

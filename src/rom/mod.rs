@@ -29,6 +29,7 @@
 //! ([`sinusoids`]).
 
 pub mod dense;
+pub mod drift;
 pub mod floor;
 pub mod forecast;
 pub mod memory;

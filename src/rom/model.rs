@@ -155,6 +155,8 @@ pub struct TimeModel {
     /// The same with the nonlinear connections (lines, fenders) linearized at equilibrium, as the
     /// frequency-domain solver has them: the linear equations of the implied RAO (the floor).
     pub stiffness_linearized: DMatrix<f64>,
+    /// The modes of (M + A_inf, the linearized stiffness) with little or no restoring ([`super::drift`]).
+    pub drift_modes: Vec<super::drift::DriftMode>,
     /// B_Q, when any entry is non-zero.
     pub quadratic: Option<DMatrix<f64>>,
     /// The nonlinear connections (mooring lines, fenders), when there are any.
@@ -343,6 +345,7 @@ impl TimeModel {
         }
         let external = sys.spec.external.has_nonlinear().then(|| sys.spec.external.clone());
         let stiffness_linearized = &stiffness + sub(&sys.spec.external.nonlinear_tangent(sys.n_states()));
+        let drift_modes = super::drift::drift_modes(&mass, &stiffness_linearized);
         let mut nl_offset = vec![0.0; sys.n_states()];
         if let Some(e) = &external {
             let z = vec![0.0; sys.n_states()];
@@ -368,6 +371,7 @@ impl TimeModel {
             damping,
             stiffness,
             stiffness_linearized,
+            drift_modes,
             quadratic,
             kernel,
             db: sys.db.clone(),

@@ -165,6 +165,7 @@ fn run_until(
             waves,
             length_s: limit as f64 * dt,
             ramp_s,
+            drift_velocity: None,
         },
     )?;
     if fc.skipped() > 0 {

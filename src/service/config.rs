@@ -99,6 +99,9 @@ pub struct ForecastConfig {
     /// Gaps in the motion history up to this long are bridged (by the estimator's curve through both
     /// ends); a longer one ends the history (what is before it counts as at rest), s.
     pub max_gap_s: f64,
+    /// The modes without restoring (a free vessel's surge, sway, yaw) drift at the mean velocity
+    /// measured over this much of the history (`rom::drift`); 0: at the last sample's velocity, s.
+    pub drift_window_s: f64,
     /// Motion samples kept per vessel beyond the radiation memory, s.
     pub history_margin_s: f64,
     /// Of a received wave field, the largest components holding this fraction of its variance are kept
@@ -132,6 +135,7 @@ impl Default for ForecastConfig {
             suppress_wave_age_s: 30.0,
             max_motion_age_s: 2.0,
             max_gap_s: 2.0,
+            drift_window_s: crate::rom::drift::DRIFT_WINDOW_S,
             history_margin_s: 10.0,
             wave_variance_kept: 0.995,
             max_clock_skew_s: 1.0,
@@ -635,6 +639,8 @@ pub const BOUNDS: &[Bound] = &[
     positive("forecast.max_motion_age_s", 3600.0, "s"),
     // a bridged gap is a curve through the motion at both ends: longer than a minute, it is invented
     positive("forecast.max_gap_s", 60.0, "s"),
+    // the drift's mean velocity: over an hour it is no longer the present drift
+    closed("forecast.drift_window_s", 0.0, 3600.0, "s"),
     // samples kept beyond the memory: sizes the history (rate x time per vessel)
     closed("forecast.history_margin_s", 0.0, 3600.0, "s"),
     closed("forecast.wave_variance_kept", 1e-6, 1.0, ""),
@@ -718,6 +724,7 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("forecast.suppress_wave_age_s", f.suppress_wave_age_s),
         one("forecast.max_motion_age_s", f.max_motion_age_s),
         one("forecast.max_gap_s", f.max_gap_s),
+        one("forecast.drift_window_s", f.drift_window_s),
         one("forecast.history_margin_s", f.history_margin_s),
         one("forecast.wave_variance_kept", f.wave_variance_kept),
         one("forecast.max_clock_skew_s", f.max_clock_skew_s),

@@ -243,6 +243,8 @@ pub struct Resampled {
     pub short: bool,
     /// A gap was bridged.
     pub gap: bool,
+    /// How many of `velocities`, counted from the newest, were measured (the rest are the rest).
+    pub known: usize,
 }
 
 /// Running mean of a restored DOF's displacement: the bias.
@@ -553,6 +555,7 @@ impl Estimator {
             velocities: vec![[0.0; 6]; n],
             short: false,
             gap: false,
+            known: 0,
         };
         let mut j = pts.len() - 1;
         let mut ended = false;
@@ -610,6 +613,7 @@ impl Estimator {
         for m in 1..=n {
             if let Some((_, v)) = at(t0_s - m as f64 * dt_s, &mut out) {
                 out.velocities[n - m] = v;
+                out.known = m;
             }
         }
         Some(out)

@@ -111,6 +111,8 @@ pub struct Job {
     x0: Vec<f64>,
     v0: Vec<f64>,
     velocities: Vec<Vec<f64>>,
+    /// How many of `velocities` (the newest) were measured, fewest over the vessels.
+    known: usize,
     waves: Vec<crate::waves::WaveComponent>,
     header: ForecastHeader,
 }
@@ -133,15 +135,18 @@ pub struct Computer {
     n_bodies: usize,
     /// Forecast length, s.
     length_s: f64,
+    /// `forecast.drift_window_s` (0: no drift estimate).
+    drift_window_s: f64,
 }
 
 impl Computer {
-    pub fn new(model: TimeModel, n_bodies: usize, length_s: f64) -> Computer {
+    pub fn new(model: TimeModel, n_bodies: usize, cfg: &ShipcastConfig) -> Computer {
         Computer {
             model,
             fc: Forecaster::new(),
             n_bodies,
-            length_s,
+            length_s: cfg.forecast.horizon_s,
+            drift_window_s: cfg.forecast.drift_window_s,
         }
     }
 
@@ -149,6 +154,17 @@ impl Computer {
     pub fn run(&mut self, job: Job, elapsed_ms: impl Fn() -> f64) -> Done {
         let (model, n_bodies) = (&self.model, self.n_bodies);
         let fc = &mut self.fc;
+        let drift = (self.drift_window_s > 0.0)
+            .then(|| {
+                crate::rom::drift::slow_velocity(
+                    &job.velocities,
+                    job.known,
+                    &job.v0,
+                    model.opts.dt_s,
+                    self.drift_window_s,
+                )
+            })
+            .flatten();
         let result = Memory::from_history(model, &job.velocities).and_then(|memory| {
             let req = ForecastRequest {
                 x0: &job.x0,
@@ -157,6 +173,7 @@ impl Computer {
                 waves: &job.waves,
                 length_s: self.length_s,
                 ramp_s: 0.0,
+                drift_velocity: drift.as_deref(),
             };
             fc.forecast(model, &req).map(|f| {
                 let mut values = Vec::with_capacity(6 * n_bodies * (f.steps + 1));
@@ -622,6 +639,7 @@ impl Engine {
             let mut x0 = vec![0.0; self.n_active];
             let mut v0 = vec![0.0; self.n_active];
             let mut velocities = vec![vec![0.0; self.n_active]; n_hist];
+            let mut known_history = n_hist;
             let mut ok = true;
             for b in 0..n_bodies {
                 let Some(r) = self.hist[b].resample(t0, dt, n_hist, cfg.max_gap_s) else {
@@ -634,6 +652,7 @@ impl Engine {
                 if r.gap {
                     fl |= flags::HISTORY_GAP;
                 }
+                known_history = known_history.min(r.known);
                 for (row, &i) in self.active.iter().enumerate() {
                     if i / 6 == b && i < 6 * n_bodies {
                         x0[row] = r.x0[i % 6];
@@ -658,7 +677,7 @@ impl Engine {
                 let waves = f.for_vessel(self.origin_m, self.heading, t0);
                 // what the field says about where it was observed decides how far it is trusted (and
                 // the variance the forecast leaves out, in `done`)
-                let known = match f.region {
+                let located = match f.region {
                     _ if f.components.is_empty() => {
                         header.flags |= flags::NO_WAVE_COMPONENTS;
                         false
@@ -671,7 +690,7 @@ impl Engine {
                 };
                 for (b, p) in self.positions.iter().enumerate() {
                     let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0).horizon_s - (t0 - f.time_s).max(0.0);
-                    header.horizon_s[b] = if known && h.is_finite() { h.max(0.0) } else { 0.0 };
+                    header.horizon_s[b] = if located && h.is_finite() { h.max(0.0) } else { 0.0 };
                 }
                 fl = header.flags;
                 self.busy = true;
@@ -680,6 +699,7 @@ impl Engine {
                     x0,
                     v0,
                     velocities,
+                    known: known_history,
                     waves,
                     header,
                 });
@@ -884,12 +904,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
     let (done_tx, mut done_rx) = tokio::sync::mpsc::channel::<Done>(4);
     let inject_panic = std::env::var(FAULT_ENV).is_ok_and(|v| v == "compute-panic");
-    let compute = compute_thread(
-        Computer::new(model, n_bodies, cfg.forecast.horizon_s),
-        job_rx,
-        done_tx,
-        inject_panic,
-    );
+    let compute = compute_thread(Computer::new(model, n_bodies, &cfg), job_rx, done_tx, inject_panic);
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));
