@@ -12,7 +12,7 @@ use crate::hydro::external::ConnectionKind;
 use crate::hydro::memory;
 use crate::hydro::radiation::{self, PairError};
 use crate::hydro::statespace::ModalModel;
-use crate::hydro::system::{AInfSource, TailChoice};
+use crate::hydro::system::{AInfSource, Passivity, TailChoice};
 use crate::hydro::{Dof, VesselSystem, mode_label};
 use crate::rao::FrequencySolver;
 use crate::rom::model::Kernel;
@@ -126,18 +126,40 @@ impl<'a> DbCheck<'a> {
             .collect();
         let fd = FrequencySolver::new(sys).table(&omegas, &db.heading_rad);
         let mut floors = vec![];
-        for (name, model) in [
+        // where the database's damping is indefinite, the convolution's floor with the other choice of
+        // `irf.passivity` too (the state space's fit is too slow to make twice)
+        let mut other = sys.clone();
+        let (this_name, other_name) = match sys.spec.irf.passivity {
+            Passivity::Project => {
+                other.spec.irf.passivity = Passivity::None;
+                ("convolution", "convolution, irf.passivity = \"none\"")
+            }
+            Passivity::None => {
+                other.spec.irf.passivity = Passivity::Project;
+                ("convolution", "convolution, irf.passivity = \"project\"")
+            }
+        };
+        let mut models = vec![
             (
-                "convolution",
+                this_name,
                 TimeModel::new(sys, model_opts(RadiationMethod::Convolution)),
+                true,
             ),
-            ("state space", ss_model),
-        ] {
+            ("state space", ss_model, true),
+        ];
+        if check.passivity_repair.frequencies > 0 {
+            models.push((
+                other_name,
+                TimeModel::new(&other, model_opts(RadiationMethod::Convolution)),
+                false,
+            ));
+        }
+        for (name, model, warn) in models {
             let floor = model.and_then(|m| floor::implied_table(&m, &omegas, &db.heading_rad));
             let line = match (&fd, floor) {
                 (Ok(fd), Ok(floor)) => match floor::worst_curve_error(&floor, fd) {
                     Some(e) => {
-                        if e.fraction > FLOOR_WARNING {
+                        if warn && e.fraction > FLOOR_WARNING {
                             warnings.push(floor_warning(sys, name, e.fraction, e.state, omegas[e.omega]));
                         }
                         FloorLine::Worst {
@@ -452,8 +474,14 @@ impl DbCheck<'_> {
         } else {
             writeln!(
                 out,
-                "passivity (radiated power >= 0 makes B positive semi-definite): B(w) indefinite at {} of {} frequencies; the models use it with the negative eigenvalues set to zero, largest change {:.4} % of sqrt(peak B_ii peak B_jj) at {:.4} rad/s",
+                "passivity (radiated power >= 0 makes B positive semi-definite): B(w) indefinite at {} of {} frequencies; {}, largest change {:.4} % of sqrt(peak B_ii peak B_jj) at {:.4} rad/s",
                 repair.frequencies,
+                match self.loaded.system.spec.irf.passivity {
+                    Passivity::Project =>
+                        "the models use it with the negative eigenvalues set to zero (irf.passivity = \"project\")",
+                    Passivity::None =>
+                        "the models use it as it is (irf.passivity = \"none\"; the projection would change it)",
+                },
                 w.len(),
                 100.0 * repair.largest,
                 w[repair.at]

@@ -1,7 +1,7 @@
 //! Recorded logs and replay (issue 7): a simulated log read by an off-the-shelf reader in Python,
 //! replayed through the daemon's engine deterministically, skill against lead time, damaged logs.
 
-use crate::util::{repo, scratch_dir, shipcast};
+use crate::util::{repo, scratch_dir, shipcast, simulate_to};
 use std::path::{Path, PathBuf};
 
 /// The simulated logs' data clock at the start (2025-06-15 UTC): fixed, so logs are reproducible.
@@ -31,16 +31,7 @@ fn config(dir: &Path) -> PathBuf {
 fn simulated_log(dir: &Path, secs: u32) -> (PathBuf, PathBuf) {
     let cfg = config(dir);
     let log = dir.join("sim.mcap");
-    let (ok, _, err) = shipcast(&[
-        "simulate",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--record",
-        log.to_str().unwrap(),
-        "--duration",
-        &secs.to_string(),
-    ]);
-    assert!(ok, "{err}");
+    simulate_to(&cfg, &log, secs as f64);
     (cfg, log)
 }
 

@@ -2,7 +2,7 @@
 //! replay` does) (issue 26): each test pins a fault found on an earlier main and says what it did.
 //! The log: three simulated minutes of the one-ship demo (`config/one-ship.toml`), made once.
 
-use crate::util::{repo, scratch_dir, shipcast};
+use crate::util::{repo, scratch_dir, simulate_to};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::{ForecastHeader, Status, flags};
 use shipcast::replay::{self, Record};
@@ -30,16 +30,7 @@ fn log() -> &'static Log {
         let cfg_path = dir.join("shipcast.toml");
         std::fs::write(&cfg_path, text).unwrap();
         let path = dir.join("sim.mcap");
-        let (ok, _, err) = shipcast(&[
-            "simulate",
-            "--config",
-            cfg_path.to_str().unwrap(),
-            "--record",
-            path.to_str().unwrap(),
-            "--duration",
-            &LOG_S.to_string(),
-        ]);
-        assert!(ok, "{err}");
+        simulate_to(&cfg_path, &path, LOG_S);
         let cfg = shipcast::service::config::load(&cfg_path).unwrap();
         let sys = shipcast::files::load_system(&repo("config/vessels/ship/system.toml"))
             .unwrap()

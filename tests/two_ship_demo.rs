@@ -6,7 +6,7 @@
 //! noise integrated over the forecast by the modes without restoring), and the free pair's forecasts
 //! closed the 5 m gap by 22 m.
 
-use crate::util::{repo, scratch_dir, shipcast};
+use crate::util::{repo, scratch_dir, simulate_to};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::ForecastHeader;
 use shipcast::replay::{self, Record};
@@ -69,16 +69,7 @@ fn log() -> &'static Log {
         let cfg_path = dir.join("shipcast.toml");
         std::fs::write(&cfg_path, text).unwrap();
         let path = dir.join("sim.mcap");
-        let (ok, _, err) = shipcast(&[
-            "simulate",
-            "--config",
-            cfg_path.to_str().unwrap(),
-            "--record",
-            path.to_str().unwrap(),
-            "--duration",
-            &LOG_S.to_string(),
-        ]);
-        assert!(ok, "{err}");
+        simulate_to(&cfg_path, &path, LOG_S);
         Log {
             cfg: shipcast::service::config::load(&cfg_path).unwrap(),
             sys: shipcast::files::load_system(&repo(&format!("config/{system}")))

@@ -10,6 +10,20 @@ pub fn repo(rel: &str) -> PathBuf {
 }
 
 /// Runs the `shipcast` binary; returns (success, stdout, stderr).
+/// `shipcast simulate --config CFG --record LOG --duration SECS`, which must succeed.
+pub fn simulate_to(cfg: &Path, log: &Path, secs: f64) {
+    let (ok, _, err) = shipcast(&[
+        "simulate",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--record",
+        log.to_str().unwrap(),
+        "--duration",
+        &secs.to_string(),
+    ]);
+    assert!(ok, "{err}");
+}
+
 pub fn shipcast(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_shipcast"))
         .args(args)

@@ -8,7 +8,7 @@
 use super::VesselSystem;
 use super::radiation::{self, DampingTail, Irf};
 use super::statespace;
-use super::system::{AInfSource, TailChoice};
+use super::system::{AInfSource, Passivity, TailChoice};
 use nalgebra::DMatrix;
 
 /// The radiation memory the time-domain models use: K(t) on t = 0, dt, ..., duration from the
@@ -22,11 +22,19 @@ pub struct RadiationMemory {
     pub fit_residuals: Option<(f64, f64)>,
 }
 
-/// [`RadiationMemory`] on t = 0, `dt_s`, ..., `duration_s` from the database's damping made passive
-/// ([`radiation::passive_damping`]).
+/// [`RadiationMemory`] on t = 0, `dt_s`, ..., `duration_s` from the database's damping as the system
+/// file's `irf.passivity` has it ([`model_damping`]).
 pub fn radiation_memory(sys: &VesselSystem, dt_s: f64, duration_s: f64) -> RadiationMemory {
-    let (b, _) = radiation::passive_damping(&sys.db.damping);
-    radiation_memory_of(sys, &b, dt_s, duration_s)
+    radiation_memory_of(sys, &model_damping(sys, &sys.db.damping), dt_s, duration_s)
+}
+
+/// The damping the time-domain models are built from: `b` made passive
+/// ([`radiation::passive_damping`]), or as it is with `irf.passivity = "none"`.
+pub fn model_damping(sys: &VesselSystem, b: &[DMatrix<f64>]) -> Vec<DMatrix<f64>> {
+    match sys.spec.irf.passivity {
+        Passivity::Project => radiation::passive_damping(b).0,
+        Passivity::None => b.to_vec(),
+    }
 }
 
 /// The same from the given damping samples (at the database's frequencies).
@@ -76,7 +84,7 @@ pub fn active_radiation(sys: &VesselSystem, a_inf: &DMatrix<f64>, tail: &Damping
     let act = sys.active_indices();
     let sub = |m: &DMatrix<f64>| DMatrix::from_fn(act.len(), act.len(), |r, c| m[(act[r], act[c])]);
     let b: Vec<DMatrix<f64>> = sys.db.damping.iter().map(sub).collect();
-    let (b, _) = radiation::passive_damping(&b);
+    let b = model_damping(sys, &b);
     ActiveRadiation {
         damping: b,
         added_mass: sys.db.added_mass.iter().map(sub).collect(),

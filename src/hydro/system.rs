@@ -28,6 +28,21 @@ pub enum TailChoice {
     Cubic,
 }
 
+/// What the time-domain models do with a damping B(w) that is not positive semi-definite (a BEM's
+/// irregular frequencies, coarse panels): `irf.passivity`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Passivity {
+    /// Negative eigenvalues set to zero at each frequency (the smallest change that makes B passive;
+    /// [`super::radiation::passive_damping`]), the default: a passive K can never make a stable hull
+    /// unstable.
+    #[default]
+    Project,
+    /// B as the database has it; the model is refused when its free motion grows
+    /// ([`crate::rom::TimeModel::new`]).
+    None,
+}
+
 /// How A_inf is obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -85,6 +100,7 @@ struct IrfFile {
     dt_s: Option<f64>,
     duration_s: Option<f64>,
     tail: Option<TailChoice>,
+    passivity: Option<Passivity>,
 }
 
 fn one() -> f64 {
@@ -128,6 +144,8 @@ pub struct IrfOptions {
     pub duration_s: Option<f64>,
     /// The damping tail beyond the database's last frequency.
     pub tail: TailChoice,
+    /// What an indefinite B(w) becomes.
+    pub passivity: Passivity,
 }
 
 impl Default for IrfOptions {
@@ -136,6 +154,7 @@ impl Default for IrfOptions {
             dt_s: 0.05,
             duration_s: None,
             tail: TailChoice::Fitted,
+            passivity: Passivity::Project,
         }
     }
 }
@@ -236,6 +255,9 @@ impl SystemSpec {
                     return Err(key("irf.duration_s", format!("must be in [1, 3600] s, found {d}")));
                 }
                 irf.duration_s = Some(d);
+            }
+            if let Some(p) = f.passivity {
+                irf.passivity = p;
             }
             if let Some(t) = f.tail {
                 irf.tail = t;

@@ -133,6 +133,10 @@ pub struct NlScratch {
     f: Vec<f64>,
 }
 
+/// The free motion of a stable model loses energy to radiation and damping; a drift mode keeps its
+/// kinetic energy: more than this growth is instability ([`TimeModel::new`] with `irf.passivity = "none"`).
+pub const FREE_MOTION_GROWTH: f64 = 1.5;
+
 /// Time-domain model over the active DOFs. Matrices are n x n with n = number of active DOFs, in the
 /// order of `active` (global 0-based mode indices).
 #[derive(Debug, Clone)]
@@ -355,7 +359,7 @@ impl TimeModel {
         let mut bdc = DMatrix::zeros(n, 2 * n);
         bdc.view_mut((0, 0), (n, n)).copy_from(&(&damping + &d_inst));
         bdc.view_mut((0, n), (n, n)).copy_from(&stiffness);
-        Ok(TimeModel {
+        let model = TimeModel {
             n_pad: super::dense::pad(n),
             cols_bdc: super::dense::columns(&bdc),
             cols_s_inv: super::dense::columns(&s_inv),
@@ -378,7 +382,64 @@ impl TimeModel {
             g_m_s2: sys.spec.g_m_s2,
             water_depth_m: sys.spec.water_depth_m,
             irf,
-        })
+        };
+        if sys.spec.irf.passivity == crate::hydro::system::Passivity::None {
+            model.check_free_motion()?;
+        }
+        Ok(model)
+    }
+
+    /// With the database's damping used as it is (`irf.passivity = "none"`), a radiation memory that
+    /// creates energy can make the free motion grow. From a small velocity on every active state, no
+    /// waves, over the memory's length (at least 60 s): Err when the energy (v^T M v + x^T C x) / 2 over
+    /// the run's last quarter exceeds [`FREE_MOTION_GROWTH`] times its start.
+    fn check_free_motion(&self) -> Result<()> {
+        let n = self.n();
+        let v0: Vec<f64> = (0..n).map(|r| 0.01 / (1.0 + r as f64)).collect();
+        let x0 = vec![0.0; n];
+        let memory = super::memory::Memory::new(self);
+        let memory_s = match &self.kernel {
+            Kernel::Convolution { taps, .. } => *taps as f64 * self.opts.dt_s,
+            Kernel::StateSpace { .. } => 300.0,
+        };
+        let length_s = memory_s.clamp(60.0, 600.0);
+        let mut fc = super::forecast::Forecaster::new();
+        let req = super::forecast::ForecastRequest {
+            x0: &x0,
+            v0: &v0,
+            memory: &memory,
+            waves: &[],
+            length_s,
+            ramp_s: 0.0,
+            drift_velocity: None,
+        };
+        let refuse = |why: String| {
+            Error::Input(format!(
+                "irf.passivity = \"none\": {why}: the database's damping creates energy (not positive semi-definite); use passivity = \"project\""
+            ))
+        };
+        let f = fc
+            .forecast(self, &req)
+            .map_err(|e| refuse(format!("the free motion diverged ({e})")))?;
+        let energy = |k: usize| {
+            let (mut e, nm) = (0.0, self.n_modes);
+            for (r, &i) in self.active.iter().enumerate() {
+                for (c, &j) in self.active.iter().enumerate() {
+                    e += 0.5 * self.mass[(r, c)] * f.v[k * nm + i] * f.v[k * nm + j];
+                    e += 0.5 * self.stiffness_linearized[(r, c)] * f.x[k * nm + i] * f.x[k * nm + j];
+                }
+            }
+            e
+        };
+        let start = energy(0);
+        let late = (3 * f.steps / 4..=f.steps).map(energy).fold(0.0, f64::max);
+        if late.is_nan() || late > FREE_MOTION_GROWTH * start {
+            return Err(refuse(format!(
+                "the free motion's energy grew {:.3e} times in {length_s:.0} s",
+                late / start
+            )));
+        }
+        Ok(())
     }
 
     /// K(i w) = B(w) + i w (A(w) - A_inf) of the model's own radiation memory (active DOFs): the
