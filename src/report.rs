@@ -381,10 +381,12 @@ impl DbCheck<'_> {
             db.exc_omega_rad_s[db.exc_omega_rad_s.len() - 1],
             db.heading_rad.len(),
             hd.join(", "),
-            if db.headings_cover_circle() {
-                " (full circle)"
-            } else {
-                ""
+            match (db.mirrored, db.headings_cover_circle()) {
+                (true, _) => {
+                    " (full circle: those over 180-360 deg, or 0-180, by port-starboard symmetry; port_starboard_symmetric = false turns it off); interpolated referred to each body's position, cubic in heading"
+                }
+                (false, true) => " (full circle); interpolated referred to each body's position, cubic in heading",
+                (false, false) => "; interpolated referred to each body's position, cubic in heading",
             }
         )
     }
@@ -476,13 +478,13 @@ impl DbCheck<'_> {
                 out,
                 "passivity (radiated power >= 0 makes B positive semi-definite): B(w) indefinite at {} of {} frequencies; {}, largest change {:.4} % of sqrt(peak B_ii peak B_jj) at {:.4} rad/s",
                 repair.frequencies,
+                w.len(),
                 match self.loaded.system.spec.irf.passivity {
                     Passivity::Project =>
                         "the models use it with the negative eigenvalues set to zero (irf.passivity = \"project\")",
                     Passivity::None =>
                         "the models use it as it is (irf.passivity = \"none\"; the projection would change it)",
                 },
-                w.len(),
                 100.0 * repair.largest,
                 w[repair.at]
             )

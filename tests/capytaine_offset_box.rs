@@ -47,3 +47,22 @@ fn off_grid_headings_of_a_body_away_from_the_origin_match_capytaine() {
         assert!(e <= tol, "{lo}-{hi} rad/s: {:.2} % at {at}", 100.0 * e);
     }
 }
+
+/// `db check` says how the headings are completed and interpolated, which passivity choice the models
+/// use, and the convolution's floor with the other one (this database's B is indefinite at 27 of its
+/// 70 frequencies, by 0.02 % of its scale).
+#[test]
+fn db_check_says_what_it_mirrored_and_the_floor_of_each_passivity_choice() {
+    let (ok, out, err) = shipcast(&["db", "check", SYSTEM]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("24 headings") && out.contains("by port-starboard symmetry"),
+        "{out}"
+    );
+    assert!(
+        out.contains("interpolated referred to each body's position, cubic in heading"),
+        "{out}"
+    );
+    assert!(out.contains("indefinite at 27 of 70 frequencies; the models use it with the negative eigenvalues set to zero (irf.passivity = \"project\"), largest change"), "{out}");
+    assert!(out.contains("  convolution, irf.passivity = \"none\" "), "{out}");
+}
