@@ -2,7 +2,7 @@
 //! replay` does) (issue 26): each test pins a fault found on an earlier main and says what it did.
 //! The log: three simulated minutes of the one-ship demo (`config/one-ship.toml`), made once.
 
-use crate::util::{repo, scratch_dir, simulate_to};
+use crate::util::{SimLog, simulated};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::{ForecastHeader, Status, flags};
 use shipcast::replay::{self, Record};
@@ -13,31 +13,9 @@ const LOG_S: f64 = 180.0;
 /// Where in the log the faults are put, s after its start: after the 60 s memory has filled.
 const FAULT_AT_S: f64 = 90.0;
 
-struct Log {
-    cfg: shipcast::service::config::ShipcastConfig,
-    sys: shipcast::hydro::VesselSystem,
-    records: Vec<(f64, Record)>,
-}
-
-fn log() -> &'static Log {
-    static LOG: OnceLock<Log> = OnceLock::new();
-    LOG.get_or_init(|| {
-        let dir = scratch_dir("trust");
-        let text = std::fs::read_to_string(repo("config/one-ship.toml")).unwrap().replace(
-            "file = \"vessels/ship/system.toml\"",
-            &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
-        );
-        let cfg_path = dir.join("shipcast.toml");
-        std::fs::write(&cfg_path, text).unwrap();
-        let path = dir.join("sim.mcap");
-        simulate_to(&cfg_path, &path, LOG_S);
-        let cfg = shipcast::service::config::load(&cfg_path).unwrap();
-        let sys = shipcast::files::load_system(&repo("config/vessels/ship/system.toml"))
-            .unwrap()
-            .system;
-        let records = replay::read(&path).unwrap().records;
-        Log { cfg, sys, records }
-    })
+fn log() -> &'static SimLog {
+    static LOG: OnceLock<SimLog> = OnceLock::new();
+    LOG.get_or_init(|| simulated("trust", "one-ship.toml", "vessels/ship/system.toml", LOG_S))
 }
 
 /// The log's first time, s.

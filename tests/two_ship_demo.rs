@@ -6,7 +6,7 @@
 //! noise integrated over the forecast by the modes without restoring), and the free pair's forecasts
 //! closed the 5 m gap by 22 m.
 
-use crate::util::{repo, scratch_dir, simulate_to};
+use crate::util::{SimLog, simulated};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::ForecastHeader;
 use shipcast::replay::{self, Record};
@@ -46,38 +46,10 @@ impl Forecast {
     }
 }
 
-struct Log {
-    cfg: shipcast::service::config::ShipcastConfig,
-    sys: shipcast::hydro::VesselSystem,
-    records: Vec<(f64, Record)>,
-}
-
-fn log() -> &'static Log {
-    static LOG: OnceLock<Log> = OnceLock::new();
-    LOG.get_or_init(|| {
-        let dir = scratch_dir("two-ship-demo");
-        let text = std::fs::read_to_string(repo("config/shipcast.toml")).unwrap();
-        let system = "vessels/pair/moored.toml";
-        assert!(
-            text.contains(&format!("file = \"{system}\"")),
-            "the demo is the moored pair"
-        );
-        let text = text.replace(
-            &format!("file = \"{system}\""),
-            &format!("file = \"{}\"", repo(&format!("config/{system}")).display()),
-        );
-        let cfg_path = dir.join("shipcast.toml");
-        std::fs::write(&cfg_path, text).unwrap();
-        let path = dir.join("sim.mcap");
-        simulate_to(&cfg_path, &path, LOG_S);
-        Log {
-            cfg: shipcast::service::config::load(&cfg_path).unwrap(),
-            sys: shipcast::files::load_system(&repo(&format!("config/{system}")))
-                .unwrap()
-                .system,
-            records: replay::read(&path).unwrap().records,
-        }
-    })
+/// The demo's log: its config's system must be the moored pair.
+fn log() -> &'static SimLog {
+    static LOG: OnceLock<SimLog> = OnceLock::new();
+    LOG.get_or_init(|| simulated("two-ship-demo", "shipcast.toml", "vessels/pair/moored.toml", LOG_S))
 }
 
 fn forecasts(drift_window_s: f64) -> Vec<Forecast> {

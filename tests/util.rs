@@ -10,6 +10,37 @@ pub fn repo(rel: &str) -> PathBuf {
 }
 
 /// Runs the `shipcast` binary; returns (success, stdout, stderr).
+/// A simulated log with the configuration and system that made it.
+pub struct SimLog {
+    pub cfg: shipcast::service::config::ShipcastConfig,
+    pub sys: shipcast::hydro::VesselSystem,
+    pub records: Vec<(f64, shipcast::replay::Record)>,
+}
+
+/// `secs` simulated seconds of `config/<config>` (whose `[system] file` must be `system`, relative to
+/// `config/`, made absolute in a copy in scratch dir `name`), recorded and read back.
+pub fn simulated(name: &str, config: &str, system: &str, secs: f64) -> SimLog {
+    let dir = scratch_dir(name);
+    let text = std::fs::read_to_string(repo(&format!("config/{config}"))).unwrap();
+    let file = format!("file = \"{system}\"");
+    assert!(text.contains(&file), "config/{config} does not say {file}");
+    let text = text.replace(
+        &file,
+        &format!("file = \"{}\"", repo(&format!("config/{system}")).display()),
+    );
+    let cfg_path = dir.join("shipcast.toml");
+    std::fs::write(&cfg_path, text).unwrap();
+    let path = dir.join("sim.mcap");
+    simulate_to(&cfg_path, &path, secs);
+    SimLog {
+        cfg: shipcast::service::config::load(&cfg_path).unwrap(),
+        sys: shipcast::files::load_system(&repo(&format!("config/{system}")))
+            .unwrap()
+            .system,
+        records: shipcast::replay::read(&path).unwrap().records,
+    }
+}
+
 /// `shipcast simulate --config CFG --record LOG --duration SECS`, which must succeed.
 pub fn simulate_to(cfg: &Path, log: &Path, secs: f64) {
     let (ok, _, err) = shipcast(&[
