@@ -618,7 +618,7 @@ fn a_version_1_log_still_replays_to_the_same_forecasts() {
     };
     // the forecasts today's shipcast replays from it are those in forecasts.mcap, bit for bit (remade
     // with `shipcast replay sim.mcap --config shipcast.toml --out forecasts.mcap` only when the model
-    // changes on purpose: last for the excitation's cubic heading interpolation and the drift estimate)
+    // changes on purpose: last for the history convolution by output pairs, which rounds differently)
     let (was, now) = (forecasts(&repo("tests/data/replay-v1/forecasts.mcap")), forecasts(&out));
     assert!(was.len() > 20, "{}", was.len());
     assert_eq!(was.len(), now.len());

@@ -87,9 +87,14 @@ pub struct Forecaster {
 
 struct HistoryFft {
     len: usize,
+    /// Active states.
+    n: usize,
     forward: Arc<dyn Fft<f64>>,
     inverse: Arc<dyn Fft<f64>>,
-    /// K-hat[(i * n + j) * len + f]
+    /// The spectra of output pairs p (rows 2p and 2p + 1 of the kernel as one complex sequence,
+    /// k_2p,j + i k_2p+1,j: the convolution's outputs are real, so one inverse FFT gives both as its real
+    /// and imaginary parts), C-hat[(p * n + j) * len + f]. Half the products and memory of one spectrum
+    /// per kernel entry.
     kernel: Vec<Complex64>,
     u: Vec<Complex64>,
     acc: Vec<Complex64>,
@@ -106,12 +111,13 @@ impl HistoryFft {
         }
     }
 
-    /// `acc` = len x (the linear convolution of the inputs with row i of the kernel), by the spectra.
-    fn output(&mut self, i: usize, n: usize) {
+    /// `acc` = len x (the linear convolutions of the inputs with rows 2p (real part) and 2p + 1
+    /// (imaginary part) of the kernel), by the spectra.
+    fn output(&mut self, p: usize, n: usize) {
         let len = self.len;
         self.acc.iter_mut().for_each(|c| *c = Complex64::default());
         for j in 0..n {
-            let kh = &self.kernel[(i * n + j) * len..(i * n + j + 1) * len];
+            let kh = &self.kernel[(p * n + j) * len..(p * n + j + 1) * len];
             let uh = &self.u[j * len..(j + 1) * len];
             for ((a, kk), uu) in self.acc.iter_mut().zip(kh).zip(uh) {
                 *a += kk * uu;
@@ -125,20 +131,24 @@ impl HistoryFft {
         let mut planner = FftPlanner::new();
         let forward = planner.plan_fft_forward(len);
         let inverse = planner.plan_fft_inverse(len);
-        let mut kernel = vec![Complex64::default(); n * n * len];
+        let pairs = n.div_ceil(2);
+        let mut kernel = vec![Complex64::default(); pairs * n * len];
         let mut scratch =
             vec![Complex64::default(); forward.get_inplace_scratch_len().max(inverse.get_inplace_scratch_len())];
-        for i in 0..n {
+        for p in 0..pairs {
+            let (i, i2) = (2 * p, 2 * p + 1);
             for j in 0..n {
-                let s = &mut kernel[(i * n + j) * len..(i * n + j + 1) * len];
+                let s = &mut kernel[(p * n + j) * len..(p * n + j + 1) * len];
                 for m in 0..taps.min(len) {
-                    s[m] = Complex64::new(k[(i * taps + m) * n + j], 0.0);
+                    let im = if i2 < n { k[(i2 * taps + m) * n + j] } else { 0.0 };
+                    s[m] = Complex64::new(k[(i * taps + m) * n + j], im);
                 }
                 forward.process_with_scratch(s, &mut scratch);
             }
         }
         HistoryFft {
             len,
+            n,
             forward,
             inverse,
             kernel,
@@ -360,11 +370,7 @@ impl Forecaster {
         };
         let (taps, n) = (*taps, model.n());
         let len = (2 * taps).next_power_of_two();
-        if self
-            .fft
-            .as_ref()
-            .is_none_or(|f| f.len != len || f.kernel.len() != n * n * len)
-        {
+        if self.fft.as_ref().is_none_or(|f| f.len != len || f.n != n) {
             self.fft = Some(HistoryFft::new(k, taps, n, len));
         }
         let Some(f) = self.fft.as_mut() else { return Ok(()) };
@@ -385,10 +391,15 @@ impl Forecaster {
         self.f0 = tmp;
         f.transform_inputs(n);
         let scale = 1.0 / len as f64;
-        for i in 0..n {
-            f.output(i, n);
+        for p in 0..n.div_ceil(2) {
+            f.output(p, n);
+            let (i, i2) = (2 * p, 2 * p + 1);
             for kk in 1..=steps.min(taps - 1) {
-                self.known[kk * n + i] = f.acc[kk + taps - 1].re * scale;
+                let y = f.acc[kk + taps - 1] * scale;
+                self.known[kk * n + i] = y.re;
+                if i2 < n {
+                    self.known[kk * n + i2] = y.im;
+                }
             }
         }
         Ok(())
