@@ -128,28 +128,23 @@ impl<'a> DbCheck<'a> {
         let mut floors = vec![];
         // where the database's damping is indefinite, the convolution's floor with the other choice of
         // `irf.passivity` too (the state space's fit is too slow to make twice)
-        let mut other = sys.clone();
-        let (this_name, other_name) = match sys.spec.irf.passivity {
-            Passivity::Project => {
-                other.spec.irf.passivity = Passivity::None;
-                ("convolution", "convolution, irf.passivity = \"none\"")
-            }
-            Passivity::None => {
-                other.spec.irf.passivity = Passivity::Project;
-                ("convolution", "convolution, irf.passivity = \"project\"")
-            }
-        };
         let mut models = vec![
             (
-                this_name,
+                "convolution",
                 TimeModel::new(sys, model_opts(RadiationMethod::Convolution)),
                 true,
             ),
             ("state space", ss_model, true),
         ];
         if check.passivity_repair.frequencies > 0 {
+            let (choice, name) = match sys.spec.irf.passivity {
+                Passivity::Project => (Passivity::None, "convolution, irf.passivity = \"none\""),
+                Passivity::None => (Passivity::Project, "convolution, irf.passivity = \"project\""),
+            };
+            let mut other = sys.clone();
+            other.spec.irf.passivity = choice;
             models.push((
-                other_name,
+                name,
                 TimeModel::new(&other, model_opts(RadiationMethod::Convolution)),
                 false,
             ));

@@ -108,7 +108,7 @@ pub fn slow_velocity(history: &[Vec<f64>], known: usize, v0: &[f64], dt_s: f64, 
 /// Sets the mean velocity of every drift mode of a forecast (x, v over `n_modes` states per step,
 /// `active` mapping active rows to states) to that of `drift_velocity`, keeping the displacement at
 /// t0: x_k -= phi c t_k, v_k -= phi c with c the forecast's Hann-weighted mean modal velocity less the
-/// drift's. Returns the largest |c| (m/s in mass-normalized units), for tests.
+/// drift's.
 pub fn apply(
     modes: &[DriftMode],
     drift_velocity: &[f64],
@@ -117,13 +117,12 @@ pub fn apply(
     dt_s: f64,
     x: &mut [f64],
     v: &mut [f64],
-) -> f64 {
+) {
     let steps = x.len() / n_modes.max(1);
     if steps < 3 {
-        return 0.0;
+        return;
     }
     let length_s = (steps - 1) as f64 * dt_s;
-    let mut worst = 0.0f64;
     for m in modes.iter().filter(|m| m.omega_rad_s * length_s < DRIFT_OMEGA_LENGTH) {
         let target: f64 = m.mass_shape.iter().zip(drift_velocity).map(|(a, b)| a * b).sum();
         let (mut mean, mut wsum) = (0.0, 0.0);
@@ -138,7 +137,6 @@ pub fn apply(
             wsum += w;
         }
         let c = mean / wsum - target;
-        worst = worst.max(c.abs());
         for k in 0..steps {
             let t = k as f64 * dt_s;
             for (p, &i) in m.shape.iter().zip(active) {
@@ -147,7 +145,6 @@ pub fn apply(
             }
         }
     }
-    worst
 }
 
 #[cfg(test)]
