@@ -91,7 +91,18 @@ pub fn load_system(path: &Path) -> Result<Loaded, Error> {
         files.push(psc);
     }
     let label = stem.display().to_string();
-    let system = VesselSystem::assemble(spec, rad, exc, hst, &label)?;
+    let speeds = spec.speed_databases.clone();
+    let mut system = VesselSystem::assemble(spec, rad, exc, hst, &label)?;
+    for (u, stem) in speeds {
+        let stem = dir.join(&stem);
+        let with_ext = |ext: &str| PathBuf::from(format!("{}.{ext}", stem.display()));
+        let (p1, p3, phst) = (with_ext("1"), with_ext("3"), with_ext("hst"));
+        let rad = wamit::read_radiation_bounded(open(&p1)?, &p1.display().to_string(), n, s, &bounds)?;
+        let exc = wamit::read_excitation_bounded(open(&p3)?, &p3.display().to_string(), n, s, &bounds)?;
+        let hst = wamit::read_hydrostatics_bounded(open(&phst)?, &phst.display().to_string(), n, s, &bounds)?;
+        system.add_speed_database(u, rad, exc, hst, &stem.display().to_string())?;
+        files.extend([p1, p3, phst]);
+    }
     Ok(Loaded { system, files, notes })
 }
 

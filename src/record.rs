@@ -24,6 +24,9 @@
 //! - `/truth` (`shipcast.Motion`): like `/motion`, the simulator's true motion (absent from real logs)
 //! - `/forecast` (`shipcast.Forecast`): `{"issue_time_s", "dt_s", "steps", "flags", "wave_time_s",
 //!   "motion_time_s", "compute_ms", "horizon_s": [..], "values": [...]}` (series-major as on the wire)
+//! - `/navigation` (`shipcast.Navigation`): `{"vessel", "time_s", "east_m", "north_m", "heading_deg",
+//!   "sog_m_s", "cog_deg", "stw_m_s", "rot_deg_s", "valid"}` (as on the wire: compass degrees,
+//!   rate of turn positive to starboard; absent from logs before version 3)
 //! - `/tick` (`shipcast.Tick`): `{"clock_s"}`, a cadence tick of a recording daemon
 //! - `/radar` (`foxglove.Grid`, Foxglove's well-known schema): the simulated radar's elevation snapshot
 //!   (frame `earth`: x east, y north, m; one FLOAT32 field `elevation_m`, 0 outside the disc), one per
@@ -32,7 +35,7 @@
 //! Version 1 logs (before JSON Schemas, metadata and `/radar`; the simulator's log times from 0) are
 //! read as they are.
 
-use crate::ipc::wire::{ForecastHeader, MotionSample, SCHEMA_VERSION};
+use crate::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
 use crate::waves::field::{FlatHeader, WaveField};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -42,8 +45,8 @@ use std::path::Path;
 
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
 /// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
-/// `/radar`.
-pub const LOG_SCHEMA_VERSION: u32 = 2;
+/// `/radar`; 3: `/navigation`.
+pub const LOG_SCHEMA_VERSION: u32 = 3;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -57,6 +60,66 @@ pub struct MotionRecord {
     pub x: [f64; 6],
     /// Velocity, body frame: m/s and rad/s (0 on `/truth`).
     pub v: [f64; 6],
+}
+
+/// A vessel's navigation fix, as on the wire (`ipc::wire::NavigationSample`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[schemars(title = "shipcast.Navigation")]
+pub struct NavigationRecord {
+    /// Index of the vessel in the system file.
+    pub vessel: u32,
+    /// The fix's stamp, UNIX seconds.
+    pub time_s: f64,
+    /// Position of the vessel's reference point, site tangent plane, m east.
+    pub east_m: f64,
+    /// ... m north.
+    pub north_m: f64,
+    /// True heading, deg clockwise from north.
+    pub heading_deg: f64,
+    /// Speed over ground, m/s.
+    pub sog_m_s: f64,
+    /// Course over ground, deg clockwise from north.
+    pub cog_deg: f64,
+    /// Speed through the water, m/s (valid bit 1).
+    pub stw_m_s: f64,
+    /// Rate of turn, deg/s, positive to starboard (valid bit 2).
+    pub rot_deg_s: f64,
+    /// Which optional values are given (`ipc::wire::nav_valid`).
+    pub valid: u32,
+}
+
+impl NavigationRecord {
+    pub fn of(n: &NavigationSample) -> NavigationRecord {
+        NavigationRecord {
+            vessel: n.vessel,
+            time_s: n.time_s,
+            east_m: n.east_m,
+            north_m: n.north_m,
+            heading_deg: n.heading_deg,
+            sog_m_s: n.sog_m_s,
+            cog_deg: n.cog_deg,
+            stw_m_s: n.stw_m_s,
+            rot_deg_s: n.rot_deg_s,
+            valid: n.valid,
+        }
+    }
+
+    pub fn to_wire(&self) -> NavigationSample {
+        NavigationSample {
+            schema_version: SCHEMA_VERSION,
+            vessel: self.vessel,
+            time_s: self.time_s,
+            east_m: self.east_m,
+            north_m: self.north_m,
+            heading_deg: self.heading_deg,
+            sog_m_s: self.sog_m_s,
+            cog_deg: self.cog_deg,
+            stw_m_s: self.stw_m_s,
+            rot_deg_s: self.rot_deg_s,
+            valid: self.valid,
+            reserved: 0,
+        }
+    }
 }
 
 /// A phase-resolved wave field (the radar processor's, or fitted to a probe).
@@ -255,10 +318,11 @@ impl RotatingRecorder {
 pub type Error = Box<dyn std::error::Error + Send + Sync>;
 
 /// The channels: topic, schema name, schema (JSON Schema of the record type).
-fn topics() -> [(&'static str, &'static str, schemars::Schema); 6] {
+fn topics() -> [(&'static str, &'static str, schemars::Schema); 7] {
     use schemars::schema_for;
     [
         ("/motion", "shipcast.Motion", schema_for!(MotionRecord)),
+        ("/navigation", "shipcast.Navigation", schema_for!(NavigationRecord)),
         ("/waves", "shipcast.Waves", schema_for!(WavesRecord)),
         ("/truth", "shipcast.Motion", schema_for!(MotionRecord)),
         ("/forecast", "shipcast.Forecast", schema_for!(ForecastRecord)),
@@ -519,6 +583,7 @@ impl<W: Write + Seek> Recorder<W> {
     pub fn record(&mut self, t: f64, r: &Record) -> Result<(), Error> {
         match r {
             Record::Motion(m) => self.write("/motion", t, m),
+            Record::Navigation(n) => self.write("/navigation", t, n),
             Record::Waves(w) => self.write("/waves", t, w),
             Record::Truth(m) => self.write("/truth", t, m),
             Record::Forecast(f) => self.write("/forecast", t, f),
@@ -557,6 +622,7 @@ impl<W: Write + Seek> Recorder<W> {
 #[derive(Debug, Clone)]
 pub enum Record {
     Motion(MotionRecord),
+    Navigation(NavigationRecord),
     Waves(WavesRecord),
     Truth(MotionRecord),
     Forecast(ForecastRecord),
@@ -613,6 +679,7 @@ pub fn read(path: &Path) -> Result<Read, Error> {
         };
         let rec = match m.channel.topic.as_str() {
             "/motion" => serde_json::from_slice(&m.data).map(Record::Motion),
+            "/navigation" => serde_json::from_slice(&m.data).map(Record::Navigation),
             "/truth" => serde_json::from_slice(&m.data).map(Record::Truth),
             "/waves" => serde_json::from_slice(&m.data).map(Record::Waves),
             "/forecast" => serde_json::from_slice(&m.data).map(Record::Forecast),

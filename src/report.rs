@@ -332,6 +332,17 @@ impl DbCheck<'_> {
                 "off (own 6x6 blocks only)"
             }
         )?;
+        if !sys.speed_dbs.is_empty() {
+            let speeds: Vec<String> = std::iter::once(0.0)
+                .chain(sys.speed_dbs.iter().map(|(u, _)| *u))
+                .map(|u| format!("{u}"))
+                .collect();
+            writeln!(
+                out,
+                "databases at forward speeds {} m/s: A and B (against the encounter frequency) quadratic in the speed, X linear; the checks below are of the zero-speed one",
+                speeds.join(", ")
+            )?;
+        }
         writeln!(out, "bodies: {} ({} modes)", sys.spec.bodies.len(), sys.n_modes())?;
         for (k, b) in sys.spec.bodies.iter().enumerate() {
             let active: Vec<&str> = (0..6).filter(|j| b.active[*j]).map(|j| Dof::ALL[j].name()).collect();

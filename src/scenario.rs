@@ -267,6 +267,7 @@ impl Prepared {
             length_s,
             ramp_s: 0.0,
             drift_velocity: None,
+            track: None,
         }
     }
 }
@@ -310,6 +311,7 @@ pub fn prepare(past: &TimeModel, model: &TimeModel, waves: &Waves, history_s: f6
             length_s: history_s,
             ramp_s: 30.0_f64.min(history_s / 2.0),
             drift_velocity: None,
+            track: None,
         },
     )?;
     let mut memory = Memory::new(model);

@@ -3,13 +3,16 @@
 //! around the ship (gridded snapshots with noise inverted by [`crate::waves::observe`]) and IMU samples
 //! with noise and bias. The shell (`shipcast simulate`) paces it in real time and publishes or records.
 //!
-//! Frames (DESIGN.md section 1): the earth frame is x east, y north; the vessels keep station (zero
-//! speed) with the system's x axis along `heading_rad` (counterclockwise from east) and the system's
-//! origin at `origin_m`. Times are seconds from the start of the simulation (the shell adds the data
-//! clock's start, `simulate.start_unix_s`).
+//! Frames (DESIGN.md section 1): the earth frame is x east, y north. The system's seakeeping frame
+//! starts at `origin_m` with its x axis along `heading_rad` (counterclockwise from east) and follows
+//! the [`Track`] (forward speed along its heading, a steady turn from a given time); the true motion is
+//! the ROM's oscillation about that frame, forced along the track ([`Forecaster::from_rest_on`]).
+//! Navigation (position and heading of each vessel's reference point, speed and course over ground,
+//! rate of turn) is the frame's pose plus the vessel's own surge, sway and yaw. Times are seconds from
+//! the start of the simulation (the shell adds the data clock's start, `simulate.start_unix_s`).
 
 use crate::hydro::VesselSystem;
-use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel};
+use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel, Track};
 use crate::waves::field::{Region, WaveField};
 use crate::waves::observe::{Grid, GridOptions, from_grids};
 use crate::waves::sea::{SeaState, realize_all};
@@ -51,6 +54,17 @@ pub struct ImuSpec {
     pub bias_rad: f64,
 }
 
+/// The navigation sensors (a GNSS and a gyro compass).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavSpec {
+    /// Samples per second (0: no navigation stream).
+    pub rate_hz: f64,
+    /// Heading noise (standard deviation), rad.
+    pub heading_noise_rad: f64,
+    /// Position noise (standard deviation, each axis), m.
+    pub position_noise_m: f64,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimSpec {
     /// The true sea: directions counterclockwise from east (travel-to).
@@ -60,8 +74,13 @@ pub struct SimSpec {
     pub duration_s: f64,
     /// Ramp of the true wave force at the start, s.
     pub ramp_s: f64,
+    /// The seakeeping frame's heading at the start (its +x, counterclockwise from east), rad.
     pub heading_rad: f64,
+    /// The system origin's earth position at the start, m.
     pub origin_m: [f64; 2],
+    /// The frame's track from the start: speed, turn.
+    pub track: Track,
+    pub navigation: NavSpec,
     /// Model error: the true vessels' linear damping is this factor times the model's.
     pub damping_factor: f64,
     pub seed: u64,
@@ -76,6 +95,31 @@ pub struct ImuSample {
     pub v: [f64; 6],
 }
 
+/// One navigation fix of a vessel (core units: the shell writes compass degrees on the wire).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavFix {
+    pub vessel: usize,
+    pub time_s: f64,
+    /// Earth position of the vessel's reference point, m.
+    pub position_m: [f64; 2],
+    /// Heading of the vessel's +x, counterclockwise from east, rad.
+    pub heading_rad: f64,
+    /// Speed over ground, m/s, and its course, counterclockwise from east, rad.
+    pub speed_m_s: f64,
+    pub course_rad: f64,
+    /// Rate of turn, counterclockwise positive, rad/s.
+    pub turn_rate_rad_s: f64,
+}
+
+/// The truth's wave force along a turning track is computed in pieces of at most this heading change,
+/// rad (0.1 deg: 20 times finer than a forecast's [`crate::rom::forecast::TURN_PIECE_RAD`], so that the
+/// truth is not the forecaster's approximation).
+pub const TRUTH_PIECE_RAD: f64 = 0.1 * std::f64::consts::PI / 180.0;
+
+/// The radar processor's map re-centres on the ship when the ship is this fraction of the radar's
+/// range from the map's centre (its snapshots must share one grid: the inversion starts over).
+pub const MAP_RECENTRE_FRACTION: f64 = 0.1;
+
 /// The simulation: truth computed once, sensors sampled on demand.
 pub struct Simulation {
     pub spec: SimSpec,
@@ -86,6 +130,10 @@ pub struct Simulation {
     pub n_bodies: usize,
     rng: ChaCha8Rng,
     grids: Vec<Grid>,
+    /// Reference points of the bodies in the system frame, m.
+    body_xy_m: Vec<[f64; 2]>,
+    /// The radar map's centre, earth frame, m.
+    map_centre_m: Option<[f64; 2]>,
 }
 
 impl Simulation {
@@ -95,7 +143,14 @@ impl Simulation {
         for b in truth_sys.spec.bodies.iter_mut() {
             b.linear_damping *= spec.damping_factor;
         }
-        let model = TimeModel::new(&truth_sys, opts)?;
+        spec.track.validate()?;
+        let model = TimeModel::new(
+            &truth_sys,
+            RomOptions {
+                speed_m_s: spec.track.speed_m_s,
+                ..opts
+            },
+        )?;
         let sea = WaveField::from_components(
             &realize_all(&spec.seas),
             sys.spec.g_m_s2,
@@ -104,10 +159,17 @@ impl Simulation {
         );
         let waves = sea.for_vessel(spec.origin_m, spec.heading_rad, 0.0);
         let truth = Forecaster::new()
-            .from_rest(&model, &waves, spec.duration_s, spec.ramp_s)?
+            .from_rest_on(&model, &waves, spec.duration_s, spec.ramp_s, Some(spec.track))?
             .clone();
         Ok(Simulation {
             n_bodies: sys.spec.bodies.len(),
+            body_xy_m: sys
+                .spec
+                .bodies
+                .iter()
+                .map(|b| [b.position_m.x, b.position_m.y])
+                .collect(),
+            map_centre_m: None,
             rng: ChaCha8Rng::seed_from_u64(spec.seed ^ 0x5eed),
             sea,
             truth,
@@ -151,6 +213,51 @@ impl Simulation {
             .collect()
     }
 
+    /// The seakeeping frame's earth heading (rad, counterclockwise from east) and origin (m) at `t_s`.
+    pub fn pose(&self, t_s: f64) -> (f64, [f64; 2]) {
+        let (psi, p) = self.spec.track.pose(t_s.max(0.0));
+        let h = self.spec.heading_rad;
+        let (s, c) = h.sin_cos();
+        let o = self.spec.origin_m;
+        (h + psi, [o[0] + c * p[0] - s * p[1], o[1] + s * p[0] + c * p[1]])
+    }
+
+    /// The navigation fixes of every vessel at `t_s`: the frame's pose plus the vessel's own surge, sway
+    /// and yaw, with the sensors' noise.
+    pub fn navigation(&mut self, t_s: f64) -> Vec<NavFix> {
+        let nav = self.spec.navigation;
+        let tr = self.spec.track;
+        let (h, o) = self.pose(t_s);
+        let turning = tr.turn_rate_rad_s != 0.0 && t_s > tr.turn_start_s;
+        let rate = if turning { tr.turn_rate_rad_s } else { 0.0 };
+        (0..self.n_bodies)
+            .map(|b| {
+                let xy = self.body_xy_m[b];
+                let (surge, sway, yaw) = (
+                    self.true_x(t_s, 6 * b),
+                    self.true_x(t_s, 6 * b + 1),
+                    self.true_x(t_s, 6 * b + 5),
+                );
+                let (x, y) = (xy[0] + surge, xy[1] + sway);
+                let (s, c) = h.sin_cos();
+                let noise = [
+                    nav.position_noise_m * gauss(&mut self.rng),
+                    nav.position_noise_m * gauss(&mut self.rng),
+                    nav.heading_noise_rad * gauss(&mut self.rng),
+                ];
+                NavFix {
+                    vessel: b,
+                    time_s: t_s,
+                    position_m: [o[0] + c * x - s * y + noise[0], o[1] + s * x + c * y + noise[1]],
+                    heading_rad: h + yaw + noise[2],
+                    speed_m_s: tr.speed_m_s,
+                    course_rad: h,
+                    turn_rate_rad_s: rate + self.true_v(t_s, 6 * b + 5),
+                }
+            })
+            .collect()
+    }
+
     /// The radar's newest snapshot (elevation, m, on its grid), if any.
     pub fn last_grid(&self) -> Option<&Grid> {
         self.grids.last()
@@ -162,7 +269,16 @@ impl Simulation {
         let r = self.spec.radar;
         let n = r.cells.max(8);
         let d = 2.0 * r.radius_m / n as f64;
-        let o = self.spec.origin_m;
+        // the map follows the ship in steps: its snapshots share one grid until it re-centres
+        let ship = self.pose(t_s).1;
+        let o = match self.map_centre_m {
+            Some(c) if (ship[0] - c[0]).hypot(ship[1] - c[1]) <= MAP_RECENTRE_FRACTION * r.radius_m => c,
+            _ => {
+                self.grids.clear();
+                ship
+            }
+        };
+        self.map_centre_m = Some(o);
         let xs: Vec<f64> = (0..n).map(|i| o[0] - r.radius_m + (i as f64 + 0.5) * d).collect();
         let ys: Vec<f64> = (0..n).map(|i| o[1] - r.radius_m + (i as f64 + 0.5) * d).collect();
         let mut pts = Vec::with_capacity(n * n);

@@ -21,6 +21,7 @@ const CORE: &[&str] = &[
     "src/sim.rs",
     "src/service/estimator.rs",
     "src/service/clock.rs",
+    "src/service/navigation.rs",
     "src/operation.rs",
     "src/console",
 ];

@@ -111,6 +111,7 @@ fn roll_decay_follows_the_decrement_law() {
         length_s: 150.0,
         ramp_s: 0.0,
         drift_velocity: None,
+        track: None,
     };
     let mut fc = Forecaster::new();
     let f = fc.forecast(&m, &req).unwrap();
@@ -292,7 +293,7 @@ proptest! {
         let mem = Memory::new(&m);
         let v0 = [v[0], v[1], v[2], 0.1 * v[3], 0.01 * v[4], 0.01 * v[5]];
         let x0 = [0.0; 6];
-        let req = ForecastRequest { x0: &x0, v0: &v0, memory: &mem, waves: &[], length_s: 200.0, ramp_s: 0.0, drift_velocity: None };
+        let req = ForecastRequest { x0: &x0, v0: &v0, memory: &mem, waves: &[], length_s: 200.0, ramp_s: 0.0, drift_velocity: None, track: None };
         let mut fc = Forecaster::new();
         let f = fc.forecast(&m, &req).unwrap();
         let energy = |k: usize| {

@@ -327,6 +327,7 @@ fn run_from_rest_history(
             length_s,
             ramp_s,
             drift_velocity: None,
+            track: None,
         },
     )
     .cloned()

@@ -6,6 +6,7 @@ mod util;
 
 mod bad_input;
 mod capytaine_barge;
+mod capytaine_barge_speeds;
 mod capytaine_demo;
 mod capytaine_messy_pair;
 mod capytaine_offset_box;
@@ -20,6 +21,7 @@ mod replay;
 mod rom;
 mod trust;
 mod two_ship_demo;
+mod underway;
 mod waves_fields;
 mod wecsim_rm3;
 mod wecsim_rm3_3dof;

@@ -20,8 +20,17 @@ pub struct SimLog {
 /// `secs` simulated seconds of `config/<config>` (whose `[system] file` must be `system`, relative to
 /// `config/`, made absolute in a copy in scratch dir `name`), recorded and read back.
 pub fn simulated(name: &str, config: &str, system: &str, secs: f64) -> SimLog {
+    simulated_with(name, config, system, secs, &[])
+}
+
+/// [`simulated`] with the config's text replaced: each (from, to) of `edits` must be found once.
+pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: &[(&str, &str)]) -> SimLog {
     let dir = scratch_dir(name);
-    let text = std::fs::read_to_string(repo(&format!("config/{config}"))).unwrap();
+    let mut text = std::fs::read_to_string(repo(&format!("config/{config}"))).unwrap();
+    for (from, to) in edits {
+        assert_eq!(text.matches(from).count(), 1, "config/{config}: {from:?} once");
+        text = text.replace(from, to);
+    }
     let file = format!("file = \"{system}\"");
     assert!(text.contains(&file), "config/{config} does not say {file}");
     let text = text.replace(

@@ -120,6 +120,7 @@ fn forces_sample_by_sample_match_wecsim() {
         length_s: DURATION_S,
         ramp_s: RAMP_S,
         drift_velocity: None,
+        track: None,
     };
     let force = Forecaster::new().force_for(&m, &req).unwrap();
     let n = m.n();

@@ -125,8 +125,20 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
         },
         duration_s,
         ramp_s: s.ramp_s,
-        heading_rad: heading_from_compass_deg(cfg.site.heading_deg),
+        heading_rad: heading_from_compass_deg(s.track.heading_deg.unwrap_or(cfg.site.heading_deg)),
         origin_m: [cfg.site.origin_east_m, cfg.site.origin_north_m],
+        // compass rate of turn (to starboard) is clockwise: the track's is counterclockwise
+        track: shipcast::rom::Track {
+            speed_m_s: s.track.speed_m_s,
+            turn_rate_rad_s: -s.track.turn_deg_s.to_radians(),
+            turn_start_s: s.track.turn_start_s,
+            piece_rad: shipcast::sim::TRUTH_PIECE_RAD,
+        },
+        navigation: shipcast::sim::NavSpec {
+            rate_hz: s.navigation.rate_hz,
+            heading_noise_rad: s.navigation.heading_noise_deg.to_radians(),
+            position_noise_m: s.navigation.position_noise_m,
+        },
         damping_factor: s.damping_factor,
         seed: s.seed,
     }
@@ -185,6 +197,9 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
     let radar_dt = cfg.simulate.radar.period_s;
     let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
+    let nav_rate = cfg.simulate.navigation.rate_hz;
+    let nav_dt = if nav_rate > 0.0 { 1.0 / nav_rate } else { f64::INFINITY };
+    let mut next_nav = 0.0f64;
     let grid_every = cfg.simulate.radar.record_grid_every;
     let mut scans = 0u64;
     let start = Instant::now();
@@ -196,7 +211,25 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         let _ = ctrlc_flag(stop);
     }
     while next_imu <= duration && !stop_seen {
-        let t = next_imu.min(next_radar);
+        let t = next_imu.min(next_radar).min(next_nav);
+        if next_nav <= next_imu && next_nav <= next_radar {
+            for fix in sim.navigation(t) {
+                let n = shipcast::service::navigation::to_wire(fix.vessel as u32, t + epoch, &fix);
+                if let Some(p) = &publisher {
+                    let due = Duration::from_secs_f64(t / speed);
+                    if let Some(wait) = due.checked_sub(start.elapsed()) {
+                        std::thread::sleep(wait);
+                    }
+                    p.navigation(&n)
+                        .map_err(|e| anyhow::anyhow!("publishing navigation: {e}"))?;
+                } else if let Some(rec) = recorder.as_mut() {
+                    rec.write("/navigation", t + epoch, &shipcast::record::NavigationRecord::of(&n))
+                        .map_err(|e| anyhow::anyhow!("{e}"))?;
+                }
+            }
+            next_nav += nav_dt;
+            continue;
+        }
         if let Some(p) = &publisher {
             let due = Duration::from_secs_f64(t / speed);
             if let Some(wait) = due.checked_sub(start.elapsed()) {

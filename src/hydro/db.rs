@@ -222,6 +222,94 @@ impl HydroDb {
     }
 
     /// Zeroes every 6x6 block coupling two different bodies (`hydrodynamic_coupling = false`).
+    /// The database at forward speed `speed_m_s` from databases at several speeds (speed, database;
+    /// speeds ascending), all on the same grids and prepared alike (coupling, body referral, symmetry).
+    /// A(w_e) and B(w_e) are quadratic in the speed through the three nearest speeds (Capytaine's
+    /// forward-speed radiation is exactly quadratic in U at a given encounter frequency; linear between
+    /// the two when only two are given); X(w, beta) is linear between the two speeds either side (at a
+    /// given wave frequency the encounter frequency moves with U, and a quadratic overshoots as often
+    /// as it helps). A_inf, A(0) and C are the first database's. Never extrapolated: a speed outside
+    /// the databases' is an error.
+    pub fn interpolate_speed(dbs: &[(f64, &HydroDb)], speed_m_s: f64) -> Result<HydroDb> {
+        let (Some(first), Some(last)) = (dbs.first(), dbs.last()) else {
+            return Err(Error::OutOfRange("no database to interpolate in speed".into()));
+        };
+        if !(speed_m_s.is_finite() && speed_m_s >= first.0 - 1e-12 && speed_m_s <= last.0 + 1e-12) {
+            return Err(Error::OutOfRange(format!(
+                "forward speed {speed_m_s} m/s is outside the databases' speeds {}..{} m/s",
+                first.0, last.0
+            )));
+        }
+        let base = first.1;
+        for (u, d) in dbs {
+            let same = |a: &[f64], b: &[f64]| {
+                a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-9 * x.abs().max(1.0))
+            };
+            let what = if d.n_modes != base.n_modes {
+                Some("modes")
+            } else if !same(&d.omega_rad_s, &base.omega_rad_s) {
+                Some("radiation frequencies")
+            } else if !same(&d.exc_omega_rad_s, &base.exc_omega_rad_s) {
+                Some("excitation frequencies")
+            } else if !same(&d.heading_rad, &base.heading_rad) {
+                Some("headings")
+            } else {
+                None
+            };
+            if let Some(what) = what {
+                return Err(Error::OutOfRange(format!(
+                    "the database at {u} m/s has other {what} than the one at {} m/s: databases interpolated in speed must share their grids",
+                    first.0
+                )));
+            }
+        }
+        // the bracketing pair (linear) and the three nearest speeds (quadratic)
+        let hi = dbs
+            .iter()
+            .position(|(u, _)| *u >= speed_m_s)
+            .unwrap_or(dbs.len() - 1)
+            .max(1);
+        let lo = hi - 1;
+        let t = (speed_m_s - dbs[lo].0) / (dbs[hi].0 - dbs[lo].0);
+        let linear = [(lo, 1.0 - t), (hi, t)];
+        let quadratic: Vec<(usize, f64)> = if dbs.len() < 3 {
+            linear.to_vec()
+        } else {
+            // the window of three consecutive speeds around the speed whose middle is nearest it
+            let start = (0..=dbs.len() - 3)
+                .filter(|&i| dbs[i].0 <= speed_m_s && speed_m_s <= dbs[i + 2].0)
+                .min_by(|&i, &j| {
+                    (dbs[i + 1].0 - speed_m_s)
+                        .abs()
+                        .total_cmp(&(dbs[j + 1].0 - speed_m_s).abs())
+                })
+                .unwrap_or(0);
+            let idx = [start, start + 1, start + 2];
+            idx.iter()
+                .map(|&i| {
+                    let w = idx
+                        .iter()
+                        .filter(|&&j| j != i)
+                        .map(|&j| (speed_m_s - dbs[j].0) / (dbs[i].0 - dbs[j].0))
+                        .product::<f64>();
+                    (i, w)
+                })
+                .collect()
+        };
+        let mut out = base.clone();
+        for (k, (a, b)) in out.added_mass.iter_mut().zip(out.damping.iter_mut()).enumerate() {
+            *a = quadratic.iter().map(|&(i, w)| &dbs[i].1.added_mass[k] * w).sum();
+            *b = quadratic.iter().map(|&(i, w)| &dbs[i].1.damping[k] * w).sum();
+        }
+        for (k, x) in out.excitation.iter_mut().enumerate() {
+            *x = linear.iter().map(|&(i, w)| dbs[i].1.excitation[k] * w).sum();
+        }
+        for (k, x) in out.referred.iter_mut().enumerate() {
+            *x = linear.iter().map(|&(i, w)| dbs[i].1.referred[k] * w).sum();
+        }
+        Ok(out)
+    }
+
     pub fn decouple(&mut self) {
         let mask = |m: &mut DMatrix<f64>| {
             for i in 0..m.nrows() {

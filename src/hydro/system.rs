@@ -61,10 +61,22 @@ enum DepthSpec {
     Metres(f64),
 }
 
+/// One `[[database]]` entry: a WAMIT file set computed at a forward speed.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpeedDatabaseFile {
+    speed_m_s: f64,
+    wamit: String,
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SystemFile {
     wamit: String,
+    /// Databases at forward speeds (A and B against the encounter frequency, X against the wave
+    /// frequency); `wamit` is the one at zero speed.
+    #[serde(default)]
+    database: Vec<SpeedDatabaseFile>,
     #[serde(default = "one")]
     ulen: f64,
     rho: f64,
@@ -184,8 +196,11 @@ pub struct Body {
 /// The validated system file, before the database is attached.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSpec {
-    /// Stem of the WAMIT files, relative to the system file.
+    /// Stem of the WAMIT files, relative to the system file: the database at zero speed.
     pub wamit_stem: String,
+    /// `[[database]]`: (forward speed, m/s; stem) of databases at other speeds, speeds ascending and
+    /// positive (an entry at speed 0 must name `wamit` itself and is left out here).
+    pub speed_databases: Vec<(f64, String)>,
     pub ulen_m: f64,
     pub rho_kg_m3: f64,
     pub g_m_s2: f64,
@@ -232,6 +247,41 @@ impl SystemSpec {
         }
         if raw.wamit.trim().is_empty() {
             return Err(key("wamit", "must name the stem of the WAMIT files".into()));
+        }
+        let mut speed_databases: Vec<(f64, String)> = vec![];
+        for (i, d) in raw.database.iter().enumerate() {
+            let at = format!("database[{i}]");
+            if !(d.speed_m_s.is_finite() && d.speed_m_s >= 0.0 && d.speed_m_s <= MAX_DATABASE_SPEED_M_S) {
+                return Err(key(
+                    &format!("{at}.speed_m_s"),
+                    format!("must be in [0, {MAX_DATABASE_SPEED_M_S}] m/s, found {}", d.speed_m_s),
+                ));
+            }
+            if d.wamit.trim().is_empty() {
+                return Err(key(
+                    &format!("{at}.wamit"),
+                    "must name the stem of the WAMIT files".into(),
+                ));
+            }
+            if d.speed_m_s == 0.0 {
+                if d.wamit != raw.wamit {
+                    return Err(key(
+                        &format!("{at}.wamit"),
+                        format!(
+                            "the database at speed 0 is `wamit` (\"{}\"), found \"{}\"",
+                            raw.wamit, d.wamit
+                        ),
+                    ));
+                }
+                continue;
+            }
+            if speed_databases.last().is_some_and(|(u, _)| *u >= d.speed_m_s) {
+                return Err(key(
+                    &format!("{at}.speed_m_s"),
+                    "the databases' speeds must be listed in increasing order, each once".into(),
+                ));
+            }
+            speed_databases.push((d.speed_m_s, d.wamit.clone()));
         }
         let water_depth_m = match raw.water_depth {
             DepthSpec::Word(w) if w == "infinite" => None,
@@ -310,6 +360,7 @@ impl SystemSpec {
         .map_err(|(k, msg)| key(&k, msg))?;
         Ok(SystemSpec {
             wamit_stem: raw.wamit,
+            speed_databases,
             ulen_m: raw.ulen,
             rho_kg_m3: raw.rho,
             g_m_s2: raw.g,
@@ -489,6 +540,9 @@ pub struct LinearTerms {
     pub stiffness: DMatrix<f64>,
 }
 
+/// The fastest forward speed a `[[database]]` may be computed at, m/s (the model's own bound).
+pub const MAX_DATABASE_SPEED_M_S: f64 = 25.0;
+
 /// A vessel system: bodies, their hydrodynamic database and system-level terms, ready for the solvers.
 /// The coupling switch is already applied: with `hydrodynamic_coupling = false` every 6x6 block between
 /// two different bodies of A(w), B(w), A_inf and C is zero.
@@ -496,11 +550,73 @@ pub struct LinearTerms {
 pub struct VesselSystem {
     pub spec: SystemSpec,
     pub db: HydroDb,
+    /// Databases at forward speeds (speed, m/s, ascending and positive), prepared like `db` (coupling
+    /// switch, body referral); `db` is the one at zero speed. [`VesselSystem::at_speed`] interpolates.
+    pub speed_dbs: Vec<(f64, HydroDb)>,
     /// Warnings found while assembling (shown by `shipcast db check`).
     pub warnings: Vec<String>,
 }
 
 impl VesselSystem {
+    /// Adds a database at a forward speed (`[[database]]`), prepared as the zero-speed one is (the
+    /// coupling switch, each body's referral, port-starboard symmetry); `file` labels errors.
+    pub fn add_speed_database(
+        &mut self,
+        speed_m_s: f64,
+        rad: Radiation,
+        exc: Excitation,
+        restoring: DMatrix<f64>,
+        file: &str,
+    ) -> Result<()> {
+        let mut db = HydroDb::new(rad, exc, restoring, file)?;
+        if !self.spec.hydrodynamic_coupling {
+            db.decouple();
+        }
+        let origins: Vec<[f64; 2]> = self
+            .spec
+            .bodies
+            .iter()
+            .map(|b| [b.position_m.x, b.position_m.y])
+            .collect();
+        db.set_bodies(
+            &origins,
+            self.spec.g_m_s2,
+            self.spec.water_depth_m,
+            self.spec.port_starboard_symmetric,
+        )
+        .map_err(|msg| Error::Key {
+            file: file.into(),
+            key: "port_starboard_symmetric".into(),
+            msg,
+        })?;
+        // the same grids as the zero-speed database, checked now rather than at the first forecast
+        HydroDb::interpolate_speed(&[(0.0, &self.db), (speed_m_s, &db)], speed_m_s).map_err(|e| Error::Invalid {
+            file: file.into(),
+            msg: e.to_string(),
+        })?;
+        self.speed_dbs.push((speed_m_s, db));
+        Ok(())
+    }
+
+    /// The system at forward speed `speed_m_s`: its database interpolated between the databases at
+    /// several speeds ([`HydroDb::interpolate_speed`]; `|speed|`, astern taken as ahead). Without
+    /// databases at other speeds, the system as it is (the zero-speed database at every speed).
+    pub fn at_speed(&self, speed_m_s: f64) -> Result<VesselSystem> {
+        if self.speed_dbs.is_empty() {
+            return Ok(self.clone());
+        }
+        let dbs: Vec<(f64, &HydroDb)> = std::iter::once((0.0, &self.db))
+            .chain(self.speed_dbs.iter().map(|(u, d)| (*u, d)))
+            .collect();
+        let db = HydroDb::interpolate_speed(&dbs, speed_m_s.abs())?;
+        Ok(VesselSystem {
+            spec: self.spec.clone(),
+            db,
+            speed_dbs: vec![],
+            warnings: self.warnings.clone(),
+        })
+    }
+
     /// Attaches the WAMIT data to a validated system file; `file` labels errors (the WAMIT stem).
     pub fn assemble(
         spec: SystemSpec,
@@ -547,7 +663,12 @@ impl VesselSystem {
         if asym > 1e-6 * c.amax() {
             warnings.push(format!("the restoring matrix is not symmetric (largest |C_ij - C_ji| = {asym:.4e}): is the body in equilibrium?"));
         }
-        let sys = VesselSystem { spec, db, warnings };
+        let sys = VesselSystem {
+            spec,
+            db,
+            speed_dbs: vec![],
+            warnings,
+        };
         // a tank's free-surface effect must leave the roll restoring positive
         let c = sys.stiffness();
         for (k, t) in sys.spec.external.tanks.iter().enumerate() {

@@ -32,7 +32,7 @@ fn err(e: impl std::fmt::Display) -> Error {
     e.to_string().into()
 }
 
-/// The service names of one deployment: `<prefix>/motion|waves|forecast|status`.
+/// The service names of one deployment: `<prefix>/motion|navigation|waves|forecast|status`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Names {
     pub prefix: String,
@@ -80,6 +80,15 @@ type FixedService<T> = iceoryx2::service::port_factory::publish_subscribe::PortF
 fn motion_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<MotionSample>> {
     node.service_builder(&names.name("motion")?)
         .publish_subscribe::<MotionSample>()
+        .subscriber_max_buffer_size(BUFFER)
+        .max_publishers(8)
+        .open_or_create()
+        .map_err(err)
+}
+
+fn navigation_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<NavigationSample>> {
+    node.service_builder(&names.name("navigation")?)
+        .publish_subscribe::<NavigationSample>()
         .subscriber_max_buffer_size(BUFFER)
         .max_publishers(8)
         .open_or_create()
@@ -139,6 +148,7 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
 #[derive(Debug, Clone)]
 pub enum Input {
     Motion(MotionSample),
+    Navigation(NavigationSample),
     Waves(WaveField),
     /// A sample that could not be decoded (counted, logged).
     Rejected(String),
@@ -165,11 +175,17 @@ pub fn spawn_input(
                     .subscriber_builder()
                     .create()
                     .map_err(err)?;
+                let nav = navigation_service(&node, &names)?
+                    .subscriber_builder()
+                    .buffer_size(BUFFER)
+                    .create()
+                    .map_err(err)?;
                 let (_, motion_l) = event(&node, &names, "motion")?;
                 let (_, waves_l) = event(&node, &names, "waves")?;
-                Ok((node, motion, waves, motion_l, waves_l))
+                let (_, nav_l) = event(&node, &names, "navigation")?;
+                Ok((node, (motion, nav, waves), (motion_l, nav_l, waves_l)))
             };
-            let (node, motion, waves, motion_l, waves_l) = match setup() {
+            let (node, (motion, nav, waves), (motion_l, nav_l, waves_l)) = match setup() {
                 Ok(s) => {
                     let _ = ready.send(Ok(()));
                     s
@@ -187,21 +203,29 @@ pub fn spawn_input(
                     return;
                 }
             };
-            let (Ok(_g1), Ok(_g2), Ok(_g3)) = (
+            let (Ok(_g1), Ok(_g2), Ok(_g3), Ok(_g4)) = (
                 ws.attach_notification(&motion_l),
                 ws.attach_notification(&waves_l),
+                ws.attach_notification(&nav_l),
                 ws.attach_interval(STOP_CHECK),
             ) else {
                 tracing::error!("input thread: cannot attach to the waitset");
                 return;
             };
             let drain = |motion: &Subscriber<ipc::Service, MotionSample, ()>,
+                         nav: &Subscriber<ipc::Service, NavigationSample, ()>,
                          waves: &Subscriber<ipc::Service, [f64], WaveHeader>|
              -> bool {
                 let _ = motion_l.try_wait(|_| {});
                 let _ = waves_l.try_wait(|_| {});
+                let _ = nav_l.try_wait(|_| {});
                 while let Ok(Some(s)) = motion.receive() {
                     if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
+                        return false;
+                    }
+                }
+                while let Ok(Some(s)) = nav.receive() {
+                    if tx.blocking_send(Input::Navigation(*s.payload())).is_err() {
                         return false;
                     }
                 }
@@ -217,7 +241,7 @@ pub fn spawn_input(
                 true
             };
             // whatever was there before we attached (history of the waves service)
-            if !drain(&motion, &waves) {
+            if !drain(&motion, &nav, &waves) {
                 return;
             }
             loop {
@@ -226,7 +250,7 @@ pub fn spawn_input(
                 }
                 let mut alive = true;
                 let r = ws.wait_and_process_once(|_| {
-                    alive = drain(&motion, &waves);
+                    alive = drain(&motion, &nav, &waves);
                     CallbackProgression::Stop
                 });
                 if r.is_err() || !alive {
@@ -310,6 +334,8 @@ pub fn spawn_output(
 pub struct SensorPublisher {
     _node: Node<ipc::Service>,
     motion: Publisher<ipc::Service, MotionSample, ()>,
+    nav: Publisher<ipc::Service, NavigationSample, ()>,
+    nav_n: Notifier<ipc::Service>,
     waves: Publisher<ipc::Service, [f64], WaveHeader>,
     motion_n: Notifier<ipc::Service>,
     waves_n: Notifier<ipc::Service>,
@@ -328,11 +354,18 @@ impl SensorPublisher {
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .create()
             .map_err(err)?;
+        let nav = navigation_service(&node, names)?
+            .publisher_builder()
+            .create()
+            .map_err(err)?;
         let (motion_n, _) = event(&node, names, "motion")?;
         let (waves_n, _) = event(&node, names, "waves")?;
+        let (nav_n, _) = event(&node, names, "navigation")?;
         Ok(SensorPublisher {
             _node: node,
             motion,
+            nav,
+            nav_n,
             waves,
             motion_n,
             waves_n,
@@ -347,6 +380,17 @@ impl SensorPublisher {
             .send()
             .map_err(err)?;
         self.motion_n.notify().map_err(err)?;
+        Ok(())
+    }
+
+    pub fn navigation(&self, s: &NavigationSample) -> Result<()> {
+        self.nav
+            .loan_uninit()
+            .map_err(err)?
+            .write_payload(*s)
+            .send()
+            .map_err(err)?;
+        self.nav_n.notify().map_err(err)?;
         Ok(())
     }
 

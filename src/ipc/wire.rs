@@ -9,7 +9,8 @@
 //!
 //! Services (names `<prefix>/<kind>`, each paired with an event service of the same name that is
 //! notified after every send):
-//! - `motion`: [`MotionSample`], one per IMU/navigation sample, any vessel.
+//! - `motion`: [`MotionSample`], one per IMU sample, any vessel.
+//! - `navigation`: [`NavigationSample`], one per GNSS/gyro fix, any vessel (its own rate, 1-10 Hz).
 //! - `waves`: a slice of f64 with a [`WaveHeader`]: 4 values per component: omega (rad/s), direction
 //!   (rad, earth), Re and Im of the complex amplitude (m) at the header's reference point and time.
 //! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
@@ -76,6 +77,13 @@ pub mod flags {
     /// A vessel's motion estimate restarted from a run of refused samples that agree (a real jump),
     /// since the last status (status only): its history restarts.
     pub const MOTION_RESTARTED: u32 = 8192;
+    /// The system's heading and position are not from navigation: no vessel has published any (the
+    /// `[site]` heading and origin, a vessel keeping station), or it went stale beyond
+    /// `forecast.max_navigation_age_s` (the last known pose, trusted horizon 0).
+    pub const NAVIGATION_FALLBACK: u32 = 16384;
+    /// Wave components meet the vessel at an encounter frequency below one cycle over the forecast
+    /// (following seas at speed): kept, their force quasi-static.
+    pub const QUASI_STATIC_WAVES: u32 = 32768;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -94,6 +102,8 @@ pub mod flags {
             (CLOCKS_DISAGREE, "clocks_disagree"),
             (MOTION_IMPLAUSIBLE, "motion_implausible"),
             (MOTION_RESTARTED, "motion_restarted"),
+            (NAVIGATION_FALLBACK, "navigation_fallback"),
+            (QUASI_STATIC_WAVES, "quasi_static_waves"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)
@@ -116,6 +126,47 @@ pub struct MotionSample {
     pub x: [f64; 6],
     /// Velocity (m/s, rad/s).
     pub v: [f64; 6],
+}
+
+/// One navigation fix of one vessel (a GNSS receiver and a gyro compass, fused or not). 80 bytes.
+/// Marine conventions at this edge: compass angles in degrees clockwise from true north, rate of turn
+/// positive to starboard; the daemon converts them once, on arrival, to its earth frame (x east, y
+/// north, angles counterclockwise from east, rad). Optional values are marked in `valid`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_NavigationSample_v1")]
+#[repr(C)]
+pub struct NavigationSample {
+    pub schema_version: u32,
+    /// Index of the vessel (its body in the system file, 0-based).
+    pub vessel: u32,
+    /// Fix time, s (data clock).
+    pub time_s: f64,
+    /// Position of the vessel's reference point in the site's tangent plane (`[site]`'s east-north
+    /// frame), m east and m north.
+    pub east_m: f64,
+    pub north_m: f64,
+    /// True heading of the vessel's +x axis, deg clockwise from north.
+    pub heading_deg: f64,
+    /// Speed over ground, m/s.
+    pub sog_m_s: f64,
+    /// Course over ground, deg clockwise from north.
+    pub cog_deg: f64,
+    /// Speed through the water, m/s (when `valid` has [`nav_valid::STW`]).
+    pub stw_m_s: f64,
+    /// Rate of turn, deg/s, positive to starboard (when `valid` has [`nav_valid::ROT`]).
+    pub rot_deg_s: f64,
+    /// Which optional values are given: [`nav_valid`] bits.
+    pub valid: u32,
+    pub reserved: u32,
+}
+
+/// Bits of [`NavigationSample::valid`]: the values a sensor gives beyond time, position, heading and
+/// speed and course over ground (always required).
+pub mod nav_valid {
+    /// `stw_m_s` is given.
+    pub const STW: u32 = 1;
+    /// `rot_deg_s` is given.
+    pub const ROT: u32 = 2;
 }
 
 /// Header of a wave-field sample. 64 bytes.
@@ -368,6 +419,7 @@ mod tests {
     #[test]
     fn layouts_are_what_the_docs_say() {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
+        assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
         assert_eq!(std::mem::size_of::<Status>(), 360);

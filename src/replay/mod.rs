@@ -4,7 +4,7 @@
 //! The log's records and reader are [`crate::record`]'s; the ones replay's callers use with [`drive`] are
 //! re-exported here.
 
-pub use crate::record::{Error, ForecastRecord, MotionRecord, Read, Record, WavesRecord, read};
+pub use crate::record::{Error, ForecastRecord, MotionRecord, NavigationRecord, Read, Record, WavesRecord, read};
 
 pub mod import;
 
@@ -26,7 +26,7 @@ pub fn drive(
     crate::service::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
-    let mut computer = Computer::new(model, sys.spec.bodies.len(), cfg);
+    let mut computer = Computer::new(model, sys, cfg);
     let period = cfg.forecast.period_s;
     // ticks on the grid t0 + k period; past this long after the last input no tick can issue a forecast
     // (the motion is stale), so a gap in the log is crossed in one step, not a tick per period
@@ -67,11 +67,12 @@ pub fn drive(
             }
             grid = Some((t0, k));
         }
-        if matches!(r, Record::Motion(_) | Record::Waves(_)) {
+        if matches!(r, Record::Motion(_) | Record::Waves(_) | Record::Navigation(_)) {
             last_input_s = *t;
         }
         match r {
             Record::Motion(m) => engine.input(Input::Motion(m.to_wire()), *t),
+            Record::Navigation(n) => engine.input(Input::Navigation(n.to_wire()), *t),
             Record::Waves(w) => match w.field() {
                 Ok(f) => engine.input(Input::Waves(f), *t),
                 Err(e) => engine.input(Input::Rejected(e), *t),

@@ -39,7 +39,107 @@ pub struct ForecastRequest<'a> {
     /// of the modes without restoring over the forecast is set to it ([`super::drift::apply`]). None:
     /// the forecast runs from `v0` as it is.
     pub drift_velocity: Option<&'a [f64]>,
+    /// The vessels' track over the forecast (forward speed, turn). None: straight ahead at the model's
+    /// speed (`RomOptions::speed_m_s`).
+    pub track: Option<Track>,
 }
+
+/// The track of the seakeeping frame over a forecast, relative to its pose at t0 (x along the heading
+/// at t0, y to port): the frame advances at `speed_m_s` along its own heading, which is constant until
+/// `turn_start_s` and then turns at `turn_rate_rad_s` (counterclockwise seen from above, i.e. to port,
+/// positive). The motions are small oscillations about this frame; the frame's own turn adds no force
+/// (the centripetal and Coriolis terms of order U r are left out: 0.01 m/s^2 at 3 m/s and 0.2 deg/s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Track {
+    /// Forward speed through the water, m/s.
+    pub speed_m_s: f64,
+    /// Rate of turn, rad/s, counterclockwise positive (to port).
+    pub turn_rate_rad_s: f64,
+    /// Time after t0 the turn starts, s (0: turning from t0).
+    pub turn_start_s: f64,
+    /// The largest heading change over one piece of the wave force, rad (default [`TURN_PIECE_RAD`];
+    /// the simulator's truth takes finer pieces).
+    pub piece_rad: f64,
+}
+
+/// A turning track's wave force is computed in pieces over which the heading changes by at most this
+/// much, rad (2 deg). Over a piece the frame moves along the chord of its arc, and each component's
+/// excitation goes linearly from its value at the piece's start heading to that at its end: the
+/// heading's error is then second order, and the chord departs from the arc by U r T^2 / 8 (0.13 m
+/// over the 10 s piece of a 0.2 deg/s turn at 3 m/s: 0.013 rad of a 6 s wave's phase). Each piece costs
+/// two sums of sinusoids over every component (a straight forecast's wave force costs one).
+pub const TURN_PIECE_RAD: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
+impl Track {
+    /// A straight track at `speed_m_s`.
+    pub fn straight(speed_m_s: f64) -> Track {
+        Track {
+            speed_m_s,
+            turn_rate_rad_s: 0.0,
+            turn_start_s: 0.0,
+            piece_rad: TURN_PIECE_RAD,
+        }
+    }
+
+    /// Checks the numbers: finite, |speed| within the model's bound, |rate| at most 10 deg/s (a ship's
+    /// turn; beyond it the frame's own accelerations are not small).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.speed_m_s.is_finite() && self.speed_m_s.abs() <= super::model::MAX_SPEED_M_S) {
+            return Err(Error::Input(format!(
+                "track speed {} m/s: must be finite and at most {} m/s",
+                self.speed_m_s,
+                super::model::MAX_SPEED_M_S
+            )));
+        }
+        if !(self.turn_rate_rad_s.is_finite() && self.turn_rate_rad_s.abs() <= MAX_TURN_RATE_RAD_S) {
+            return Err(Error::Input(format!(
+                "track rate of turn {} deg/s: must be finite and at most {} deg/s",
+                self.turn_rate_rad_s.to_degrees(),
+                MAX_TURN_RATE_RAD_S.to_degrees()
+            )));
+        }
+        if !(self.piece_rad.is_finite() && self.piece_rad >= MIN_PIECE_RAD) {
+            return Err(Error::Input(format!(
+                "track piece {} deg: must be at least {} deg",
+                self.piece_rad.to_degrees(),
+                MIN_PIECE_RAD.to_degrees()
+            )));
+        }
+        if !self.turn_start_s.is_finite() {
+            return Err(Error::Input(format!(
+                "track turn start {} s: must be finite",
+                self.turn_start_s
+            )));
+        }
+        Ok(())
+    }
+
+    /// The frame's heading change (rad) and position (m, in the t0 frame) at `t_s` after t0.
+    pub fn pose(&self, t_s: f64) -> (f64, [f64; 2]) {
+        let u = self.speed_m_s;
+        let ts = self.turn_start_s.max(0.0);
+        if t_s <= ts || self.turn_rate_rad_s == 0.0 {
+            return (0.0, [u * t_s, 0.0]);
+        }
+        let r = self.turn_rate_rad_s;
+        let tau = t_s - ts;
+        let psi = r * tau;
+        // the arc: U/r (sin psi, 1 - cos psi), written so that small r loses no digits
+        let (s, c) = (psi.sin(), psi.cos());
+        let (along, across) = if psi.abs() < 1e-6 {
+            (u * tau, 0.5 * u * r * tau * tau)
+        } else {
+            (u * s / r, u * (1.0 - c) / r)
+        };
+        (psi, [u * ts + along, across])
+    }
+}
+
+/// The finest piece a [`Track`] may ask for, rad (0.01 deg: pieces cost a sum each).
+pub const MIN_PIECE_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
+
+/// The fastest turn a [`Track`] may have, rad/s (10 deg/s).
+pub const MAX_TURN_RATE_RAD_S: f64 = 10.0 * std::f64::consts::PI / 180.0;
 
 /// A forecast: every state (6N body modes then the tanks; inactive ones zero) on t = t0 + k dt,
 /// k = 0..steps. Points, relative motions and connection forces: [`super::outputs`].
@@ -58,6 +158,11 @@ pub struct Forecast {
     pub skipped_components: usize,
     /// Their share of the field's variance, sum |a|^2 / 2.
     pub skipped_variance_fraction: f64,
+    /// Components met at an encounter frequency below one cycle over the forecast (following seas at
+    /// speed: w_e = w - k U cos(beta) passes through zero), in any piece of the track. They are kept:
+    /// their force is quasi-static (Re{X a exp(i w_e t)} with w_e near or at 0 is finite), and counted
+    /// here so that the caller can say so.
+    pub quasi_static_components: usize,
 }
 
 impl Forecast {
@@ -79,6 +184,16 @@ pub struct Forecaster {
     xbuf: Vec<Complex64>,
     kept_we: Vec<f64>,
     kept_x: Vec<Complex64>,
+    /// Wave number of each component, rad/m.
+    k_rad_m: Vec<f64>,
+    /// Per component: left out, quasi-static, the sign of its last encounter frequency.
+    marks: Vec<(bool, bool, i8)>,
+    /// A turning track's pieces: each component's excitation at the current piece's end (every mode),
+    /// whether it is known, the kept components' change of X a over the piece, and its sum.
+    x_ends: Vec<Complex64>,
+    x_ends_known: Vec<bool>,
+    kept_dx: Vec<Complex64>,
+    ramp: Vec<f64>,
     f0: Vec<f64>,
     // FFT of the kernel (convolution with a history), built on first use; the forecast's own
     // velocities are the stepper's ([`super::partitioned`])
@@ -178,6 +293,12 @@ impl Forecaster {
             xbuf: vec![],
             kept_we: vec![],
             kept_x: vec![],
+            k_rad_m: vec![],
+            marks: vec![],
+            x_ends: vec![],
+            x_ends_known: vec![],
+            kept_dx: vec![],
+            ramp: vec![],
             f0: vec![],
             fft: None,
         }
@@ -200,7 +321,7 @@ impl Forecaster {
                 "forecast length {length_s} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}"
             )));
         }
-        self.wave_force(model, req.waves, steps, req.ramp_s)?;
+        self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
         // the known radiation part: the convolution's only (the modal states carry their own past)
         self.known.clear();
         if matches!(model.kernel, Kernel::Convolution { .. }) {
@@ -269,6 +390,18 @@ impl Forecaster {
         length_s: f64,
         ramp_s: f64,
     ) -> Result<&Forecast> {
+        self.from_rest_on(model, waves, length_s, ramp_s, None)
+    }
+
+    /// A run from rest along a track (None: straight at the model's speed).
+    pub fn from_rest_on(
+        &mut self,
+        model: &TimeModel,
+        waves: &[WaveComponent],
+        length_s: f64,
+        ramp_s: f64,
+        track: Option<Track>,
+    ) -> Result<&Forecast> {
         let z = vec![0.0; model.n()];
         let memory = Memory::new(model);
         let req = ForecastRequest {
@@ -279,6 +412,7 @@ impl Forecaster {
             length_s,
             ramp_s,
             drift_velocity: None,
+            track,
         };
         self.forecast(model, &req)
     }
@@ -287,7 +421,7 @@ impl Forecaster {
     /// same code as a forecast.
     pub fn force_for(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<Vec<f64>> {
         let steps = (req.length_s / model.opts.dt_s).round() as usize;
-        self.wave_force(model, req.waves, steps, req.ramp_s)?;
+        self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
         Ok(self.force.clone())
     }
 
@@ -296,16 +430,23 @@ impl Forecaster {
         self.out.skipped_components
     }
 
-    /// F_wave at t0 + k dt for k = 0..steps: sum over components of Re{X a exp(i w_e t)}.
-    fn wave_force(&mut self, model: &TimeModel, waves: &[WaveComponent], steps: usize, ramp_s: f64) -> Result<()> {
+    /// F_wave at t0 + k dt for k = 0..steps: sum over components of Re{X a exp(i w_e t)}, in pieces of
+    /// the track over which the heading changes by at most `track.piece_rad` (one piece when it does
+    /// not turn).
+    fn wave_force(
+        &mut self,
+        model: &TimeModel,
+        waves: &[WaveComponent],
+        steps: usize,
+        ramp_s: f64,
+        track: Option<Track>,
+    ) -> Result<()> {
         let n = model.n();
         let dt = model.opts.dt_s;
-        let u = model.opts.speed_m_s;
-        self.xbuf.resize(model.n_modes, Complex64::default());
-        self.kept_we.clear();
-        self.kept_x.clear();
-        let (mut total, mut skipped) = (0.0, 0.0);
-        self.out.skipped_components = 0;
+        let track = track.unwrap_or_else(|| Track::straight(model.opts.speed_m_s));
+        track.validate()?;
+        let mut total = 0.0;
+        self.k_rad_m.clear();
         for w in waves {
             if !(w.omega_rad_s.is_finite()
                 && w.omega_rad_s > 0.0
@@ -317,38 +458,137 @@ impl Forecaster {
                     "wave component {w:?}: frequency must be positive and every value finite"
                 )));
             }
-            let var = 0.5 * w.amplitude_m.norm_sqr();
-            total += var;
-            if model
-                .db
-                .excitation_into(w.omega_rad_s, w.heading_rad, &mut self.xbuf)
-                .is_err()
-            {
-                skipped += var;
-                self.out.skipped_components += 1;
-                continue;
-            }
-            let k = wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m);
-            let we = encounter_frequency(w.omega_rad_s, k, u, w.heading_rad);
-            self.kept_we.push(we);
-            for &i in &model.active {
-                self.kept_x.push(self.xbuf[i] * w.amplitude_m);
-            }
+            total += 0.5 * w.amplitude_m.norm_sqr();
+            self.k_rad_m
+                .push(wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m));
         }
-        self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
-        let nc = self.kept_we.len();
-        self.x_rad.clear();
-        self.x_rad.extend(self.kept_we.iter().map(|we| we * dt));
-        self.q.clear();
-        self.q.resize(n * nc, Complex64::default());
-        for c in 0..nc {
-            for i in 0..n {
-                self.q[i * nc + c] = self.kept_x[c * n + i];
-            }
-        }
+        self.xbuf.resize(model.n_modes, Complex64::default());
+        // per component: left out somewhere (outside the database), quasi-static somewhere, the sign of
+        // its encounter frequency in the piece before
+        self.marks.clear();
+        self.marks.resize(waves.len(), (false, false, 0));
         self.force.clear();
         self.force.resize((steps + 1) * n, 0.0);
-        self.sums.real_sum(&self.x_rad, &self.q, n, steps + 1, &mut self.force);
+        // below one cycle over the forecast
+        let slow_rad_s = std::f64::consts::TAU / (steps.max(1) as f64 * dt);
+        let turning = track.turn_rate_rad_s != 0.0 && track.turn_start_s < steps as f64 * dt;
+        let piece_steps = if turning {
+            ((track.piece_rad / track.turn_rate_rad_s.abs() / dt).floor() as usize).max(1)
+        } else {
+            steps + 1
+        };
+        let turn_k = (track.turn_start_s.max(0.0) / dt).ceil() as usize;
+        self.x_ends.clear();
+        self.x_ends.resize(waves.len() * model.n_modes, Complex64::default());
+        self.x_ends_known.clear();
+        self.x_ends_known.resize(waves.len(), false);
+        let mut k0 = 0;
+        while k0 <= steps {
+            let k1 = if !turning {
+                steps + 1
+            } else if k0 < turn_k {
+                turn_k.min(steps + 1)
+            } else {
+                (k0 + piece_steps).min(steps + 1)
+            };
+            let t_s = k0 as f64 * dt;
+            let (psi, p) = track.pose(t_s);
+            // a turning piece: the frame moves along the chord of its arc, and the excitation goes
+            // linearly from its value at the piece's start heading to that at its end heading
+            let piece_turns = turning && k0 >= turn_k;
+            let (psi_e, v) = if piece_turns {
+                let t_e = k1 as f64 * dt;
+                let (psi_e, p_e) = track.pose(t_e);
+                (psi_e, [(p_e[0] - p[0]) / (t_e - t_s), (p_e[1] - p[1]) / (t_e - t_s)])
+            } else {
+                (psi, [track.speed_m_s, 0.0])
+            };
+            self.kept_we.clear();
+            self.kept_x.clear();
+            self.kept_dx.clear();
+            let nm = model.n_modes;
+            for (c, w) in waves.iter().enumerate() {
+                let beta = w.heading_rad - psi;
+                // the start's excitation: the previous piece's end, when it had one
+                let start_known = piece_turns && self.x_ends_known[c];
+                if start_known {
+                    self.xbuf.copy_from_slice(&self.x_ends[c * nm..(c + 1) * nm]);
+                } else if model.db.excitation_into(w.omega_rad_s, beta, &mut self.xbuf).is_err() {
+                    self.marks[c].0 = true;
+                    continue;
+                }
+                if piece_turns {
+                    let end = &mut self.x_ends[c * nm..(c + 1) * nm];
+                    // an end outside the database's headings keeps the start's value
+                    if model
+                        .db
+                        .excitation_into(w.omega_rad_s, w.heading_rad - psi_e, end)
+                        .is_err()
+                    {
+                        end.copy_from_slice(&self.xbuf);
+                    }
+                    self.x_ends_known[c] = true;
+                }
+                let k = self.k_rad_m[c];
+                let we = if piece_turns {
+                    w.omega_rad_s - k * (v[0] * w.heading_rad.cos() + v[1] * w.heading_rad.sin())
+                } else {
+                    encounter_frequency(w.omega_rad_s, k, track.speed_m_s, beta)
+                };
+                let sign = if we > 0.0 {
+                    1
+                } else if we < 0.0 {
+                    -1
+                } else {
+                    0
+                };
+                let mark = &mut self.marks[c];
+                if we.abs() < slow_rad_s || (mark.2 != 0 && sign != mark.2) {
+                    mark.1 = true;
+                }
+                mark.2 = sign;
+                // the amplitude at the frame's origin at the piece's start
+                let (sd, cd) = w.heading_rad.sin_cos();
+                let a = w.amplitude_m * Complex64::from_polar(1.0, w.omega_rad_s * t_s - k * (p[0] * cd + p[1] * sd));
+                self.kept_we.push(we);
+                for &i in &model.active {
+                    self.kept_x.push(self.xbuf[i] * a);
+                    if piece_turns {
+                        self.kept_dx.push((self.x_ends[c * nm + i] - self.xbuf[i]) * a);
+                    }
+                }
+            }
+            let nc = self.kept_we.len();
+            self.x_rad.clear();
+            self.x_rad.extend(self.kept_we.iter().map(|we| we * dt));
+            transpose_into(&self.kept_x, n, nc, &mut self.q);
+            self.sums
+                .real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.force[k0 * n..k1 * n]);
+            if piece_turns {
+                // + (tau / T) Re{sum dX a exp(i w_e tau)}
+                transpose_into(&self.kept_dx, n, nc, &mut self.q);
+                self.ramp.clear();
+                self.ramp.resize((k1 - k0) * n, 0.0);
+                self.sums.real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.ramp);
+                let len = (k1 - k0) as f64;
+                for (j, row) in self.ramp.chunks(n).enumerate() {
+                    let f = &mut self.force[(k0 + j) * n..(k0 + j + 1) * n];
+                    for (fi, ri) in f.iter_mut().zip(row) {
+                        *fi += j as f64 / len * ri;
+                    }
+                }
+            }
+            k0 = k1;
+        }
+        let skipped: f64 = waves
+            .iter()
+            .zip(&self.marks)
+            .filter(|(_, m)| m.0)
+            .map(|(w, _)| 0.5 * w.amplitude_m.norm_sqr())
+            .sum();
+        self.out.skipped_components = self.marks.iter().filter(|m| m.0).count();
+        self.out.quasi_static_components = self.marks.iter().filter(|m| m.1 && !m.0).count();
+        self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
         if ramp_s > 0.0 {
             for k in 0..=steps {
                 let t = k as f64 * dt;
@@ -403,5 +643,63 @@ impl Forecaster {
             }
         }
         Ok(())
+    }
+}
+
+/// `q[i * nc + c] = rows[c * n + i]`: component-major values to the output-major layout of
+/// [`Sinusoids::real_sum`].
+fn transpose_into(rows: &[Complex64], n: usize, nc: usize, q: &mut Vec<Complex64>) {
+    q.clear();
+    q.resize(n * nc, Complex64::default());
+    for c in 0..nc {
+        for i in 0..n {
+            q[i * nc + c] = rows[c * n + i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_track_is_straight_then_an_arc_of_radius_u_over_r() {
+        let tr = Track {
+            speed_m_s: 3.0,
+            turn_rate_rad_s: 0.2f64.to_radians(),
+            turn_start_s: 100.0,
+            piece_rad: TURN_PIECE_RAD,
+        };
+        let (psi, p) = tr.pose(50.0);
+        assert_eq!((psi, p), (0.0, [150.0, 0.0]));
+        let radius = 3.0 / tr.turn_rate_rad_s;
+        for t in [100.0, 150.0, 400.0, 1900.0] {
+            let (psi, p) = tr.pose(t);
+            assert!((psi - tr.turn_rate_rad_s * (t - 100.0)).abs() < 1e-12);
+            // the arc's centre is radius to port of where the turn starts
+            let d = (p[0] - 300.0).hypot(p[1] - radius);
+            assert!((d - radius).abs() < 1e-9 * radius, "{t}: {d} vs {radius}");
+        }
+        // the arc's length is the distance run
+        let (n, t1) = (10_000, 400.0);
+        let mut len = 0.0;
+        for k in 0..n {
+            let a = tr.pose(100.0 + (t1 - 100.0) * k as f64 / n as f64).1;
+            let b = tr.pose(100.0 + (t1 - 100.0) * (k + 1) as f64 / n as f64).1;
+            len += (b[0] - a[0]).hypot(b[1] - a[1]);
+        }
+        assert!((len - 3.0 * 300.0).abs() < 1e-6, "{len}");
+    }
+
+    #[test]
+    fn tracks_beyond_a_ship_s_are_refused() {
+        assert!(Track::straight(3.0).validate().is_ok());
+        assert!(Track::straight(f64::NAN).validate().is_err());
+        assert!(Track::straight(30.0).validate().is_err());
+        let fast = Track {
+            turn_rate_rad_s: 0.5,
+            ..Track::straight(3.0)
+        };
+        assert!(fast.validate().is_err());
     }
 }

@@ -42,7 +42,7 @@ pub mod sinusoids;
 pub mod step;
 pub mod stepper;
 
-pub use forecast::{Forecast, ForecastRequest, Forecaster};
+pub use forecast::{Forecast, ForecastRequest, Forecaster, Track};
 pub use memory::Memory;
 pub use model::{OptionError, RadiationMethod, RomOptions, TimeModel};
 

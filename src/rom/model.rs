@@ -412,6 +412,7 @@ impl TimeModel {
             length_s,
             ramp_s: 0.0,
             drift_velocity: None,
+            track: None,
         };
         let refuse = |why: String| {
             Error::Input(format!(

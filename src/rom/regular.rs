@@ -166,6 +166,7 @@ fn run_until(
             length_s: limit as f64 * dt,
             ramp_s,
             drift_velocity: None,
+            track: None,
         },
     )?;
     if fc.skipped() > 0 {

@@ -121,6 +121,11 @@ pub struct ForecastConfig {
     /// A forecast whose wave field lost more than this share of its variance (components outside the
     /// database's frequencies or headings) is not trusted (trusted horizon 0), 0..1.
     pub max_dropped_wave_share: f64,
+    /// A vessel's navigation older than this (its newest fix before the motion's time) is stale: the
+    /// system's pose falls back (flag `navigation_fallback`), s.
+    pub max_navigation_age_s: f64,
+    /// The pose at a forecast's start is a straight line through this much of the newest fixes, s.
+    pub navigation_window_s: f64,
 }
 
 impl Default for ForecastConfig {
@@ -143,6 +148,8 @@ impl Default for ForecastConfig {
             clock_resync_samples: 5,
             max_clock_rate: None,
             max_dropped_wave_share: 0.1,
+            max_navigation_age_s: 5.0,
+            navigation_window_s: 30.0,
         }
     }
 }
@@ -241,6 +248,55 @@ pub struct SimulateConfig {
     pub sea: SeaConfig,
     pub radar: RadarConfig,
     pub imu: ImuConfig,
+    pub track: TrackConfig,
+    pub navigation: NavigationConfig,
+}
+
+/// The simulated ships' track (`[simulate.track]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TrackConfig {
+    /// Forward speed, m/s (default 0: keeping station).
+    pub speed_m_s: f64,
+    /// Compass heading of the system's +x at the start, deg (default: `[site]`'s).
+    pub heading_deg: Option<f64>,
+    /// Steady rate of turn, deg/s, positive to starboard (default 0).
+    pub turn_deg_s: f64,
+    /// The turn starts this long after the start, s (default 0).
+    pub turn_start_s: f64,
+}
+
+impl Default for TrackConfig {
+    fn default() -> Self {
+        TrackConfig {
+            speed_m_s: 0.0,
+            heading_deg: None,
+            turn_deg_s: 0.0,
+            turn_start_s: 0.0,
+        }
+    }
+}
+
+/// The simulated navigation sensors (`[simulate.navigation]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NavigationConfig {
+    /// Fixes per second per vessel (0: none published).
+    pub rate_hz: f64,
+    /// Heading noise, deg (standard deviation).
+    pub heading_noise_deg: f64,
+    /// Position noise, m (standard deviation, each axis).
+    pub position_noise_m: f64,
+}
+
+impl Default for NavigationConfig {
+    fn default() -> Self {
+        NavigationConfig {
+            rate_hz: 1.0,
+            heading_noise_deg: 0.1,
+            position_noise_m: 1.0,
+        }
+    }
 }
 
 impl Default for SimulateConfig {
@@ -255,6 +311,8 @@ impl Default for SimulateConfig {
             sea: SeaConfig::default(),
             radar: RadarConfig::default(),
             imu: ImuConfig::default(),
+            track: TrackConfig::default(),
+            navigation: NavigationConfig::default(),
         }
     }
 }
@@ -652,6 +710,10 @@ pub const BOUNDS: &[Bound] = &[
     // how much faster than the daemon's a source's clock may run: a simulator at its speed
     closed("forecast.max_clock_rate", 1.0, 1000.0, ""),
     closed("forecast.max_dropped_wave_share", 0.0, 1.0, ""),
+    // a fix is 0.1-1 s apart; an hour-old pose is no pose
+    positive("forecast.max_navigation_age_s", 3600.0, "s"),
+    // at least a few fixes, at most ten minutes of a turn
+    closed("forecast.navigation_window_s", 1.0, 600.0, "s"),
     // a sensor's noise: beyond these it measures nothing of a ship's motion
     positive("estimator.noise_m", 10.0, "m"),
     positive("estimator.noise_rad", 1.0, "rad"),
@@ -698,6 +760,16 @@ pub const BOUNDS: &[Bound] = &[
     closed("simulate.imu.noise_rad", 0.0, 1.0, "rad"),
     closed("simulate.imu.bias_m", -10.0, 10.0, "m"),
     closed("simulate.imu.bias_rad", -1.0, 1.0, "rad"),
+    // rom::model::MAX_SPEED_M_S (50 knots); astern allowed
+    closed("simulate.track.speed_m_s", -25.0, 25.0, "m/s"),
+    closed("simulate.track.heading_deg", -360.0, 360.0, "deg"),
+    // rom::forecast::MAX_TURN_RATE_RAD_S
+    closed("simulate.track.turn_deg_s", -10.0, 10.0, "deg/s"),
+    closed("simulate.track.turn_start_s", 0.0, DAY_S, "s"),
+    // a GNSS/gyro gives 1-10 Hz; 0: no navigation stream
+    closed("simulate.navigation.rate_hz", 0.0, 100.0, "Hz"),
+    closed("simulate.navigation.heading_noise_deg", 0.0, 10.0, "deg"),
+    closed("simulate.navigation.position_noise_m", 0.0, 100.0, "m"),
     positive("operation.duration_s", DAY_S, "s"),
     // m, or deg for rotations: beyond this every motion is inside
     positive("operation.channels.limit", 1.0e4, "m or deg"),
@@ -736,6 +808,8 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
             f.max_clock_rate,
         ),
         one("forecast.max_dropped_wave_share", f.max_dropped_wave_share),
+        one("forecast.max_navigation_age_s", f.max_navigation_age_s),
+        one("forecast.navigation_window_s", f.navigation_window_s),
         one("estimator.noise_m", c.estimator.noise_m),
         one("estimator.noise_rad", c.estimator.noise_rad),
         one("estimator.velocity_noise_m_s", c.estimator.velocity_noise_m_s),
@@ -774,6 +848,17 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.imu.noise_rad", s.imu.noise_rad),
         one("simulate.imu.bias_m", s.imu.bias_m),
         one("simulate.imu.bias_rad", s.imu.bias_rad),
+        one("simulate.track.speed_m_s", s.track.speed_m_s),
+        (
+            "simulate.track.heading_deg",
+            "simulate.track.heading_deg".into(),
+            s.track.heading_deg,
+        ),
+        one("simulate.track.turn_deg_s", s.track.turn_deg_s),
+        one("simulate.track.turn_start_s", s.track.turn_start_s),
+        one("simulate.navigation.rate_hz", s.navigation.rate_hz),
+        one("simulate.navigation.heading_noise_deg", s.navigation.heading_noise_deg),
+        one("simulate.navigation.position_noise_m", s.navigation.position_noise_m),
         one("operation.duration_s", c.operation.duration_s),
         one("console.history_s", c.console.history_s),
     ];

@@ -15,11 +15,12 @@
 pub mod clock;
 pub mod config;
 pub mod estimator;
+pub mod navigation;
 
 use crate::hydro::VesselSystem;
 use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
 use crate::ipc::{self, Input, Names, Output};
-use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel, Track};
 use crate::waves::field::{WaveField, heading_from_compass_deg};
 use crate::waves::horizon;
 use config::ShipcastConfig;
@@ -114,6 +115,8 @@ pub struct Job {
     /// How many of `velocities` (the newest) were measured, fewest over the vessels.
     known: usize,
     waves: Vec<crate::waves::WaveComponent>,
+    /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
+    track: Option<Track>,
     header: ForecastHeader,
 }
 
@@ -128,9 +131,17 @@ pub struct Done {
     pub dropped_wave_share: f64,
 }
 
+/// The speed steps the compute thread rebuilds a speed-dependent model at, m/s: the forward speed from
+/// navigation is rounded to it (B_U U and C_UQ U^2 then within 0.125 m/s of the speed's).
+pub const MODEL_SPEED_STEP_M_S: f64 = 0.25;
+
 /// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
 pub struct Computer {
     model: TimeModel,
+    /// The system and options to rebuild the model at another speed, when the system file has speed
+    /// terms (`speed_damping` B_U, `speed_restoring` C_UQ); None: one model serves every speed (the
+    /// speed then enters through the encounter frequency only).
+    rebuild: Option<(Box<VesselSystem>, RomOptions)>,
     fc: Forecaster,
     n_bodies: usize,
     /// Forecast length, s.
@@ -140,8 +151,16 @@ pub struct Computer {
 }
 
 impl Computer {
-    pub fn new(model: TimeModel, n_bodies: usize, cfg: &ShipcastConfig) -> Computer {
+    pub fn new(model: TimeModel, sys: &VesselSystem, cfg: &ShipcastConfig) -> Computer {
+        let speed_terms = sys.spec.bodies.iter().any(|b| {
+            b.speed_damping
+                .iter()
+                .chain(b.speed_restoring.iter())
+                .any(|v| *v != 0.0)
+        });
+        let n_bodies = sys.spec.bodies.len();
         Computer {
+            rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
             model,
             fc: Forecaster::new(),
             n_bodies,
@@ -150,8 +169,39 @@ impl Computer {
         }
     }
 
+    /// The model at the speed a job's track asks for, rebuilt when the system has speed terms and the
+    /// speed moved to another step of [`MODEL_SPEED_STEP_M_S`]. An error keeps the model it had.
+    fn at_speed(&mut self, track: Option<Track>) -> Result<(), String> {
+        let Some((sys, opts)) = &self.rebuild else {
+            return Ok(());
+        };
+        let want = (track.map_or(0.0, |t| t.speed_m_s) / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
+        if (want - self.model.opts.speed_m_s).abs() < 1e-9 {
+            return Ok(());
+        }
+        let model = TimeModel::new(
+            sys,
+            RomOptions {
+                speed_m_s: want,
+                ..*opts
+            },
+        )
+        .map_err(|e| format!("the model at {want} m/s: {e}"))?;
+        tracing::info!(
+            speed_m_s = want,
+            "model rebuilt for the forward speed (its speed terms)"
+        );
+        self.model = model;
+        // its workspace holds the old model's kernel spectra
+        self.fc = Forecaster::new();
+        Ok(())
+    }
+
     /// Runs one job; `elapsed_ms` measures its compute time (the shell passes a clock).
     pub fn run(&mut self, job: Job, elapsed_ms: impl Fn() -> f64) -> Done {
+        if let Err(e) = self.at_speed(job.track) {
+            tracing::warn!("{e}");
+        }
         let (model, n_bodies) = (&self.model, self.n_bodies);
         let fc = &mut self.fc;
         let drift = (self.drift_window_s > 0.0)
@@ -174,13 +224,14 @@ impl Computer {
                 length_s: self.length_s,
                 ramp_s: 0.0,
                 drift_velocity: drift.as_deref(),
+                track: job.track,
             };
             fc.forecast(model, &req).map(|f| {
                 let mut values = Vec::with_capacity(6 * n_bodies * (f.steps + 1));
                 for i in 0..6 * n_bodies {
                     values.extend((0..=f.steps).map(|k| f.at(k, i)));
                 }
-                (values, f.steps, f.skipped_variance_fraction)
+                (values, f.steps, f.skipped_variance_fraction, f.quasi_static_components)
             })
         });
         let compute_ms = elapsed_ms();
@@ -188,8 +239,11 @@ impl Computer {
         header.compute_ms = compute_ms;
         header.issue_time_s = job.t0_s;
         match result {
-            Ok((values, steps, dropped_wave_share)) => {
+            Ok((values, steps, dropped_wave_share, quasi_static)) => {
                 header.steps = steps as u32;
+                if quasi_static > 0 {
+                    header.flags |= flags::QUASI_STATIC_WAVES;
+                }
                 Done {
                     header,
                     values: Some(values),
@@ -253,6 +307,8 @@ pub struct Counters {
     /// Refused by the motion estimator as physically impossible, and its restarts after a real jump.
     pub implausible: u64,
     pub motion_restarts: u64,
+    /// Navigation fixes received.
+    pub navigation: u64,
 }
 
 /// Logs the first of a kind of event, then every time its count reaches a power of ten, so that a
@@ -402,8 +458,16 @@ pub struct Engine {
     taps: usize,
     active: Vec<usize>,
     n_active: usize,
-    positions: Vec<[f64; 2]>,
+    /// The `[site]` frame's heading (the fallback; its origin is `origin_m`).
     heading: f64,
+    /// Each body's reference point in the system frame, m.
+    body_xy_m: Vec<[f64; 2]>,
+    /// Each vessel's navigation fixes, and their clocks.
+    nav: Vec<navigation::NavTrack>,
+    nav_clock: Vec<clock::SourceClock>,
+    /// The last pose taken from navigation: (system heading, system origin, vessel velocity over
+    /// ground), kept for when navigation goes stale.
+    last_frame: Option<(f64, [f64; 2], [f64; 2])>,
     /// Each vessel's motion estimator (its kept window of samples).
     hist: Vec<Estimator>,
     /// Clock time of each vessel's newest accepted sample.
@@ -435,7 +499,7 @@ impl Engine {
             }
         };
         let keep_s = taps as f64 * model.opts.dt_s + cfg.forecast.history_margin_s;
-        let (positions, heading) = vessel_positions(cfg, sys);
+        let (_, heading) = vessel_positions(cfg, sys);
         Engine {
             cfg: cfg.forecast.clone(),
             dt_s: model.opts.dt_s,
@@ -444,8 +508,16 @@ impl Engine {
             taps,
             active: model.active.clone(),
             n_active: model.n(),
-            positions,
             heading,
+            body_xy_m: sys
+                .spec
+                .bodies
+                .iter()
+                .map(|b| [b.position_m.x, b.position_m.y])
+                .collect(),
+            nav: vec![navigation::NavTrack::default(); n_bodies],
+            nav_clock: vec![clock::SourceClock::default(); n_bodies],
+            last_frame: None,
             hist: (0..n_bodies)
                 .map(|b| Estimator::new(estimator_spec(cfg, sys, model, b), keep_s))
                 .collect(),
@@ -554,6 +626,60 @@ impl Engine {
                                 "vessel {b}: motion sample refused as physically impossible: {}",
                                 refusal_text(&why)
                             ),
+                        );
+                    }
+                }
+            }
+            Input::Navigation(n) => {
+                c.navigation += 1;
+                let b = n.vessel as usize;
+                if n.schema_version != SCHEMA_VERSION || b >= self.n_bodies {
+                    c.rejected += 1;
+                    log_count(
+                        c.rejected,
+                        &format!(
+                            "navigation fix refused: schema version {} (this daemon reads {SCHEMA_VERSION}), vessel {} of {}",
+                            n.schema_version, n.vessel, self.n_bodies
+                        ),
+                    );
+                    return;
+                }
+                match judge(
+                    &mut self.nav_clock[b],
+                    c,
+                    &format!("vessel {b}: navigation fix"),
+                    n.time_s,
+                    clock_s,
+                    &rules,
+                ) {
+                    None => return,
+                    Some(false) => {}
+                    Some(true) => {
+                        self.state_flags |= flags::CLOCK_STEP;
+                        self.nav[b].restart();
+                    }
+                }
+                match self.nav[b].push(&n, self.cfg.navigation_window_s) {
+                    Ok(()) => {}
+                    Err(navigation::NavRefusal::NonFinite) => {
+                        c.nonfinite += 1;
+                        log_count(
+                            c.nonfinite,
+                            &format!("vessel {b}: navigation fix with a non-finite value refused"),
+                        );
+                    }
+                    Err(navigation::NavRefusal::Late) => {
+                        c.late += 1;
+                        log_count(
+                            c.late,
+                            &format!("vessel {b}: navigation fix not newer than the newest refused"),
+                        );
+                    }
+                    Err(navigation::NavRefusal::Implausible(what)) => {
+                        c.rejected += 1;
+                        log_count(
+                            c.rejected,
+                            &format!("vessel {b}: navigation fix refused: its {what} is beyond what a ship does"),
                         );
                     }
                 }
@@ -674,7 +800,50 @@ impl Engine {
                     motion_time_s: t0,
                     ..ForecastHeader::default()
                 };
-                let waves = f.for_vessel(self.origin_m, self.heading, t0);
+                // the system frame at t0: from the first vessel with fresh navigation, else the last
+                // pose navigation gave (stale: not trusted), else `[site]` (keeping station)
+                let fresh = (0..n_bodies).find_map(|b| {
+                    let newest = self.nav[b].newest_time_s()?;
+                    if t0 - newest > cfg.max_navigation_age_s {
+                        return None;
+                    }
+                    self.nav[b].pose_at(t0, cfg.navigation_window_s).map(|p| (b, p))
+                });
+                let mut untrusted = false;
+                let (heading, origin, velocity, track) = match fresh {
+                    Some((b, p)) => {
+                        let (s, c) = p.heading_rad.sin_cos();
+                        let r = self.body_xy_m[b];
+                        let origin = [
+                            p.position_m[0] - (c * r[0] - s * r[1]),
+                            p.position_m[1] - (s * r[0] + c * r[1]),
+                        ];
+                        self.last_frame = Some((p.heading_rad, origin, p.velocity_m_s));
+                        let track = Track {
+                            speed_m_s: p
+                                .speed_m_s
+                                .clamp(-crate::rom::model::MAX_SPEED_M_S, crate::rom::model::MAX_SPEED_M_S),
+                            turn_rate_rad_s: p.turn_rate_rad_s.clamp(
+                                -crate::rom::forecast::MAX_TURN_RATE_RAD_S,
+                                crate::rom::forecast::MAX_TURN_RATE_RAD_S,
+                            ),
+                            turn_start_s: 0.0,
+                            piece_rad: crate::rom::forecast::TURN_PIECE_RAD,
+                        };
+                        (p.heading_rad, origin, p.velocity_m_s, Some(track))
+                    }
+                    None => {
+                        header.flags |= flags::NAVIGATION_FALLBACK;
+                        match self.last_frame {
+                            Some((h, o, _)) => {
+                                untrusted = true;
+                                (h, o, [0.0, 0.0], None)
+                            }
+                            None => (self.heading, self.origin_m, [0.0, 0.0], None),
+                        }
+                    }
+                };
+                let waves = f.for_vessel(origin, heading, t0);
                 // what the field says about where it was observed decides how far it is trusted (and
                 // the variance the forecast leaves out, in `done`)
                 let located = match f.region {
@@ -688,9 +857,15 @@ impl Engine {
                     }
                     _ => true,
                 };
-                for (b, p) in self.positions.iter().enumerate() {
-                    let h = horizon::of_field(f, *p, [0.0, 0.0], 0.0).horizon_s - (t0 - f.time_s).max(0.0);
-                    header.horizon_s[b] = if located && h.is_finite() { h.max(0.0) } else { 0.0 };
+                let (s, c) = heading.sin_cos();
+                for (b, r) in self.body_xy_m.iter().enumerate() {
+                    let p = [origin[0] + c * r[0] - s * r[1], origin[1] + s * r[0] + c * r[1]];
+                    let h = horizon::of_field(f, p, velocity, 0.0).horizon_s - (t0 - f.time_s).max(0.0);
+                    header.horizon_s[b] = if located && !untrusted && h.is_finite() {
+                        h.max(0.0)
+                    } else {
+                        0.0
+                    };
                 }
                 fl = header.flags;
                 self.busy = true;
@@ -701,6 +876,7 @@ impl Engine {
                     velocities,
                     known: known_history,
                     waves,
+                    track,
                     header,
                 });
             }
@@ -849,6 +1025,7 @@ fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, 
             }),
         ),
         Input::Waves(f) => record(recorder, t, Record::Waves(WavesRecord::of(f))),
+        Input::Navigation(n) => record(recorder, t, Record::Navigation(crate::record::NavigationRecord::of(n))),
         Input::Rejected(_) => {}
     }
 }
@@ -886,7 +1063,6 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
     watchdog_fits(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6))?;
     fits_the_wire(&sys)?;
-    let n_bodies = sys.spec.bodies.len();
     let (model, mut engine) = build(&cfg, &sys)?;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
@@ -904,7 +1080,7 @@ pub async fn run(cfg: ShipcastConfig, sys: VesselSystem, stop: Arc<AtomicBool>) 
     let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
     let (done_tx, mut done_rx) = tokio::sync::mpsc::channel::<Done>(4);
     let inject_panic = std::env::var(FAULT_ENV).is_ok_and(|v| v == "compute-panic");
-    let compute = compute_thread(Computer::new(model, n_bodies, &cfg), job_rx, done_tx, inject_panic);
+    let compute = compute_thread(Computer::new(model, &sys, &cfg), job_rx, done_tx, inject_panic);
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));

@@ -24,16 +24,48 @@ Usage: python3 make_db.py --preset ship OUTDIR      (one 180 m ship)
        python3 make_db.py --preset box-test OUTDIR  (tiny, seconds: a smoke test of this script)
        python3 make_db.py --preset offset-box OUTDIR   (the barge placed at x = 40 m; RAO at off-grid headings)
        python3 make_db.py --preset messy-pair OUTDIR   (two 12 m boxes 6.5 m apart, no lid: B indefinite above 3 rad/s)
-"""
+       python3 make_db.py --preset barge-speeds OUTDIR (the barge at 0, 2, 4 m/s and, directly, 3 m/s)
+
+Forward speed (a preset with `speeds`, e.g. barge-speeds) writes one file set per speed, <stem>.1/.3/.hst,
+the zero-speed one named by system.toml's `wamit`, the speed set listed in system.toml's [[database]]
+entries (speed_m_s, wamit), and <stem>.toml for each set solved directly outside the speed set. Capytaine 3.0.0's approximate forward-speed model (single rigid body;
+theory manual "Problem with forward speed", Donatini et al. 2022): the problem is solved at the encounter
+frequency w_e = |w - k U cos beta| with the ZERO-speed free-surface Green function at k_e = w_e^2 / g (no
+U d/dx in the free-surface condition), the body condition gains the m-terms of a uniform stream -U only
+(-U d(dr)/dx . n: pitch and yaw; the steady double-body flow is neglected), and the pressure is
+rho (i w_e phi + U dphi/dx) (exp(-i w t)). Speed sets are written in this convention:
+
+One WAMIT file set per forward speed U (m/s, the body moving to +x), solved by Capytaine's approximate
+forward-speed model (single rigid body). Conventions as at zero speed (DESIGN.md section 1; exp(+i w t),
+Capytaine's exp(-i w t) values conjugated), and:
+- .1: A and B as functions of the ENCOUNTER frequency w_e: PER = 2 pi / w_e, B = rho w_e Bbar, on the same
+  grid of w_e as the preset's frequencies (the range of the zero-speed set). Each row is one radiation
+  problem solved at encounter frequency w_e (Capytaine's RadiationProblem takes a wave frequency and
+  heading and solves at w_e = |w - k U cos beta|; it is solved with w = w_e, beta = 90 deg, so w_e = w;
+  its result depends on w_e and U only). A_ij is the force in mode i due to motion in mode j; at U != 0 A
+  and B are written as solved, NOT symmetrized (A_ij(U) = A_ji(-U): the asymmetry is physical).
+  PER = 0 (w_e = infinity) rows: the zero-speed A_inf (Capytaine solves no infinite frequency at speed;
+  in its model A(w_e, U) tends to A_inf(U = 0) as w_e grows, while B(w_e, U) tends to a nonzero constant
+  in the pitch-heave / yaw-sway couplings). No PER = -1 row at U != 0 (A(w_e -> 0) grows like U^2 / w_e^2).
+- .3: X per metre of wave amplitude as a function of the ABSOLUTE wave frequency w (PER = 2 pi / w) and
+  heading beta (to, counterclockwise from +x; 180 deg = head seas): the force in the frame moving with the
+  body is Re{ X exp(i w_e' t) }, w_e' = w - k U cos beta the SIGNED encounter frequency, for the wave
+  eta = Re{ exp(i (w t - k (x_E cos beta + y sin beta))) }, x_E = x + U t (earth and moving frames
+  coincide at t = 0): the phase is referred to the wave crest at the body origin at t = 0. Where w_e' < 0
+  (following seas, U cos beta > g / w) the Capytaine value is written unconjugated (it is solved at |w_e'|
+  with the conjugate incident wave), so X is continuous through w_e' = 0.
+- .hst: as at zero speed (no speed-dependent restoring, no sinkage or trim)."""
 
 import argparse
 import math
+import os
 import sys
 import time
 
 import numpy as np
 import xarray as xr
 import capytaine as cpt
+from capytaine.bem.airy_waves import airy_waves_velocity
 
 RHO = 1025.0
 G = 9.81
@@ -326,19 +358,44 @@ PRESETS["messy-pair"] = dict(
 )
 
 
+# barge-speeds: the barge preset's hull, panels, mass properties and lid (placed for the barge's 3 rad/s via
+# lid_omega) at forward speeds 0, 2 and 4 m/s (the speed set, system.toml's [[database]]) and, solved directly, 3 m/s (the
+# target of a test of interpolation in speed), in the convention of the module docstring: A and B on the
+# grid of ENCOUNTER frequencies 0.3-2.5 rad/s, X on the grid of wave frequencies 0.3-2.5 rad/s (every 0.05:
+# those of the barge preset's grid coincide), headings 0-180 deg every 30 (the hull is symmetric
+# port-starboard and on the x axis); Capytaine's RAO at 0 m/s (capytaine_rao.csv, the database's headings)
+# and at 3 m/s (capytaine_rao_u3.csv, 90-180 deg, from A and B solved at each (w, beta)).
+# Run (966 s beside a cargo build, load 3.5-4.6; 0 / 2 / 4 / 3 m/s: 21 / 255 / 241 / 448 s, a diffraction
+# problem at speed about 0.7 s; 384 hull + 147 lid panels, lid at z = -0.646 m as the barge's): the zero-speed
+# set equals config/vessels/barge at their 28 common frequencies to 1e-14 of each mode's scale
+# (tools/bem/check_speed_interp.py --against). At speed: the .3 needs w_e from 0.0025 to 5.05 rad/s (4 m/s;
+# head seas beyond the .1's 2.5 and the lid's 3.75 rad/s), one cell with w_e < 0 (4 m/s, beta 0, 2.5 rad/s);
+# the symmetric part of B(w_e) is indefinite at nearly every frequency (scaled eigenvalue down to -1.23 at
+# 4 m/s: the pitch-heave couplings B35, B53 are not antisymmetric in Capytaine's model). In Capytaine's model
+# A and B at a fixed w_e are exactly quadratic in U (the Green function depends on w_e only; the body
+# condition and the pressure are linear in U): interpolation through 0, 2, 4 m/s reproduces the direct 3 m/s
+# diagonals to round-off (couplings to 0.16 % / 0.43 % of their peak: u0 is symmetrized), linear between 2 and
+# 4 m/s misses A55 by 6.8 % of its peak (at 0.3 rad/s) and B55 by 0.96 %. X at a fixed w is not (w_e moves with
+# U): linear 4.6 % (heave) to 31 % (surge, beta 60, 2.3 rad/s) of the curve's peak, quadratic no better;
+# 1.6-7 % below 1.5 rad/s.
+PRESETS["barge-speeds"] = dict(
+    PRESETS["barge"],
+    stem="barge_u0",
+    lid_omega=3.0,
+    omegas=np.round(np.arange(0.3, 2.5001, 0.05), 4),
+    headings_deg=np.arange(0.0, 180.0001, 30.0),
+    # (stem, forward speed in m/s, listed in system.toml's [[database]])
+    speeds=[("barge_u0", 0.0, True), ("barge_u2", 2.0, True), ("barge_u4", 4.0, True), ("direct_u3", 3.0, False)],
+    rao_headings_deg={"barge_u0": np.arange(0.0, 180.0001, 30.0), "direct_u3": np.arange(90.0, 180.0001, 30.0)},
+)
+
+
 def fmt(v):
     return f"{v:.7e}"
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--preset", choices=sorted(PRESETS), required=True)
-    ap.add_argument("outdir")
-    args = ap.parse_args()
-    p = PRESETS[args.preset]
-    import os
-    os.makedirs(args.outdir, exist_ok=True)
-    t0 = time.time()
+def build_system(p):
+    """The preset's bodies with their mass properties and hydrostatics; (built, bodies, system, dof names)."""
     omegas = np.asarray(p["omegas"], dtype=float)
     omega_max = float(omegas.max())
     built = [make_body(b["name"], b["hull"], b["length"], b["beam"], b["draft"], b["position"], p["panel_m"],
@@ -353,64 +410,62 @@ def main():
         print(f"{body.name}: {body.mesh.nb_faces} hull panels, {lid_text}, mass {mass:.4e} kg, CoG {cog}",
               flush=True)
     system = bodies[0] if len(bodies) == 1 else cpt.Multibody(bodies)
-    dof_names = list(system.dofs.keys())
-    nmodes = len(dof_names)
+    return built, bodies, system, list(system.dofs.keys())
+
+
+def make_solver(p):
     # unless a preset chooses otherwise (every preset before session 12), Capytaine's defaults: the indirect
     # (source) formulation, the Green function's singularities integrated for low frequencies
     bem_method = p.get("bem_method", "indirect")
     gf_singularities = p.get("gf_singularities", "low_freq")
     solver = cpt.BEMSolver(green_function=cpt.Delhommeau(gf_singularities=gf_singularities), method=bem_method)
+    return solver, bem_method, gf_singularities
 
-    # The database's headings (the .3 file) and the headings of Capytaine's RAO (capytaine_rao.csv; a preset's
-    # `rao_headings_deg`, by default the database's): the diffraction problems are solved at both.
-    db_headings = np.asarray(p["headings_deg"], dtype=float)
-    rao_headings = np.asarray(p.get("rao_headings_deg", db_headings), dtype=float)
-    solved_headings = np.unique(np.round(np.concatenate([db_headings, rao_headings]), 9))
-    db_index = [int(np.argmin(np.abs(solved_headings - h))) for h in db_headings]
-    rao_index = [int(np.argmin(np.abs(solved_headings - h))) for h in rao_headings]
-    headings_rad = np.radians(solved_headings)
-    test = xr.Dataset(coords={"omega": omegas, "wave_direction": headings_rad,
-                              "radiating_dof": dof_names, "water_depth": [np.inf], "rho": [RHO], "g": [G]})
-    ds = solver.fill_dataset(test, system, progress_bar=False)
-    # infinite-frequency and zero-frequency added mass (radiation only)
-    limits = xr.Dataset(coords={"omega": [0.0, np.inf], "radiating_dof": dof_names, "water_depth": [np.inf],
-                                "rho": [RHO], "g": [G]})
-    ds_lim = solver.fill_dataset(limits, system, progress_bar=False)
-    t_solve = time.time() - t0
-    # Reciprocity: radiation added mass and damping are symmetric matrices (Green's second identity); a
-    # panel method's are not, by its discretization error (measured on the pair preset: up to 3 % of
-    # sqrt(A_ii A_jj) in A, 4 % in B, and a heave-yaw coupling between the two hulls off by a factor 15
-    # at low frequency, which alone moved the lighter's beam-sea yaw RAO by 6 %). No time-domain model
-    # can be both passive and unsymmetric, and the two BEM estimates of each coupling are equally good:
-    # write their mean, and record how far apart they were.
+
+def symmetrize(dset, names, dof_names, key_suffix=""):
+    """Reciprocity: radiation added mass and damping are symmetric matrices (Green's second identity); a
+    panel method's are not, by its discretization error (measured on the pair preset: up to 3 % of
+    sqrt(A_ii A_jj) in A, 4 % in B, and a heave-yaw coupling between the two hulls off by a factor 15
+    at low frequency, which alone moved the lighter's beam-sea yaw RAO by 6 %). No time-domain model
+    can be both passive and unsymmetric, and the two BEM estimates of each coupling are equally good:
+    write their mean, and record how far apart they were. (At zero forward speed only: at speed the
+    asymmetry is physical.) Returns {name + key_suffix: worst}."""
     asym = {}
-    for dset, names in ((ds, ("added_mass", "radiation_damping")), (ds_lim, ("added_mass",))):
-        for name in names:
-            da = dset[name]
-            swapped = da.rename({"radiating_dof": "influenced_dof", "influenced_dof": "radiating_dof"})
-            sym = 0.5 * (da + swapped).transpose(*da.dims)
-            diag = np.sqrt(np.abs(np.asarray([da.sel(radiating_dof=d, influenced_dof=d).values
-                                              for d in dof_names])).reshape(len(dof_names), -1).max(axis=1))
-            scale = xr.DataArray(np.outer(diag, diag), dims=("radiating_dof", "influenced_dof"),
-                                 coords={"radiating_dof": dof_names, "influenced_dof": dof_names})
-            worst = float((np.abs(da - swapped) / scale.where(scale > 0)).max())
-            key = name if dset is ds else name + "_limits"
-            asym[key] = worst
-            print(f"{key}: largest asymmetry {100 * worst:.3f} % of sqrt(X_ii X_jj), symmetrized", flush=True)
-            dset[name] = sym
+    for name in names:
+        da = dset[name]
+        swapped = da.rename({"radiating_dof": "influenced_dof", "influenced_dof": "radiating_dof"})
+        sym = 0.5 * (da + swapped).transpose(*da.dims)
+        diag = np.sqrt(np.abs(np.asarray([da.sel(radiating_dof=d, influenced_dof=d).values
+                                          for d in dof_names])).reshape(len(dof_names), -1).max(axis=1))
+        scale = xr.DataArray(np.outer(diag, diag), dims=("radiating_dof", "influenced_dof"),
+                             coords={"radiating_dof": dof_names, "influenced_dof": dof_names})
+        worst = float((np.abs(da - swapped) / scale.where(scale > 0)).max())
+        key = name + key_suffix
+        asym[key] = worst
+        print(f"{key}: largest asymmetry {100 * worst:.3f} % of sqrt(X_ii X_jj), symmetrized", flush=True)
+        dset[name] = sym
+    return asym
 
-    mmat = np.asarray(system.inertia_matrix)
-    cmat = np.asarray(system.hydrostatic_stiffness)
-    ds["inertia_matrix"] = system.inertia_matrix
-    ds["hydrostatic_stiffness"] = system.hydrostatic_stiffness
-    # Viscous roll damping (potential flow alone leaves ship roll almost undamped, 0.1 % of critical here):
-    # a linear B44 giving `roll_damping_ratio` of critical at each body's roll natural frequency. Written
-    # to system.toml as linear_damping and passed to Capytaine's RAO as dissipation, so both agree.
+
+def asymmetry(mats):
+    """Largest |X_ij - X_ji| / sqrt(max|X_ii| max|X_jj|) of matrices mats[iw, i, j] (not symmetrized)."""
+    diag = np.sqrt(np.abs(np.diagonal(mats, axis1=1, axis2=2)).max(axis=0))
+    scale = np.outer(diag, diag)
+    scale = np.where(scale > 0, scale, np.nan)
+    return float(np.nanmax(np.abs(mats - np.transpose(mats, (0, 2, 1))) / scale))
+
+
+def roll_damping(a_diag, omegas, mmat, cmat, specs):
+    """Viscous roll damping (potential flow alone leaves ship roll almost undamped, 0.1 % of critical here):
+    a linear B44 giving `roll_damping_ratio` of critical at each body's roll natural frequency. Written
+    to system.toml as linear_damping and passed to Capytaine's RAO as dissipation, so both agree.
+    a_diag[iw, i]: the diagonal of A(w). Returns (dissipation matrix, B44 per body)."""
+    nmodes = mmat.shape[0]
     dissipation = np.zeros((nmodes, nmodes))
     roll_b44 = []
-    for k, spec in enumerate(p["bodies"]):
+    for k, spec in enumerate(specs):
         i = 6 * k + 3
-        am = ds["added_mass"].sel(radiating_dof=dof_names[i], influenced_dof=dof_names[i]).values
+        am = a_diag[:, i]
         w = math.sqrt(cmat[i, i] / mmat[i, i])
         for _ in range(50):
             a44 = float(np.interp(w, omegas, am))
@@ -419,60 +474,66 @@ def main():
         b44 = 2.0 * spec.get("roll_damping_ratio", 0.0) * math.sqrt(cmat[i, i] * (mmat[i, i] + a44))
         dissipation[i, i] = b44
         roll_b44.append(b44)
-        print(f"{spec['name']}: roll natural frequency {w:.4f} rad/s, linear roll damping {b44:.4e} N m s/rad", flush=True)
-    rao = cpt.post_pro.rao(ds, dissipation=system.add_dofs_labels_to_matrix(dissipation))
+        print(f"{spec['name']}: roll natural frequency {w:.4f} rad/s, linear roll damping {b44:.4e} N m s/rad",
+              flush=True)
+    return dissipation, roll_b44
 
-    def sel(da, **kw):
-        return np.asarray(da.sel(**kw).squeeze().values)
 
-    stem = os.path.join(args.outdir, p["stem"])
-    # .1: PER I J Abar Bbar; A = rho Abar, B = rho w Bbar (ULEN = 1)
-    with open(stem + ".1", "w") as f:
-        lim_a = ds_lim["added_mass"]
-        for omega, per in ((0.0, -1.0), (np.inf, 0.0)):
-            a = np.asarray(lim_a.sel(omega=omega).transpose("radiating_dof", "influenced_dof", ...)
-                           .values).reshape(nmodes, nmodes)
+def write_radiation(path, omegas, a, b, limits):
+    """.1: PER I J Abar Bbar; A = rho Abar, B = rho w Bbar (ULEN = 1). a[iw, i, j], b[iw, i, j]: WAMIT's A_ij,
+    the force in mode i due to motion in mode j (SI); limits: [(PER, A[i, j])] rows first (PER = -1: w = 0,
+    PER = 0: w = infinity)."""
+    nmodes = a.shape[1]
+    with open(path, "w") as f:
+        for per, lim in limits:
             for i in range(nmodes):
                 for j in range(nmodes):
-                    # WAMIT A_ij: force in mode i due to motion in mode j
-                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(a[j, i] / RHO)}\n")
-        for omega in omegas:
-            a = np.asarray(ds["added_mass"].sel(omega=omega).transpose("radiating_dof", "influenced_dof").values)
-            b = np.asarray(ds["radiation_damping"].sel(omega=omega)
-                           .transpose("radiating_dof", "influenced_dof").values)
-            per = 2 * np.pi / omega
-            for i in range(nmodes):
-                for j in range(nmodes):
-                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(a[j, i] / RHO)} {fmt(b[j, i] / (RHO * omega))}\n")
-    # .3: PER BETA I |X| phase Re Im; X = rho g (Re + i Im), exp(+i w t): conjugate Capytaine's value
-    with open(stem + ".3", "w") as f:
-        exc = ds["excitation_force"].transpose("omega", "wave_direction", "influenced_dof")
+                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(lim[i, j] / RHO)}\n")
         for io_, omega in enumerate(omegas):
             per = 2 * np.pi / omega
-            for ib, beta in zip(db_index, db_headings):
-                for i in range(nmodes):
-                    x = np.conj(complex(exc.values[io_, ib, i])) / (RHO * G)
-                    f.write(f"{fmt(per)} {fmt(beta)} {i + 1:3d} {fmt(abs(x))} {fmt(np.degrees(np.angle(x)))} "
-                            f"{fmt(x.real)} {fmt(x.imag)}\n")
-    # .hst: I J Cbar, C = rho g Cbar
-    with open(stem + ".hst", "w") as f:
-        for i in range(nmodes):
-            for j in range(nmodes):
+            for i in range(nmodes):
+                for j in range(nmodes):
+                    f.write(f"{fmt(per)} {i + 1:3d} {j + 1:3d} {fmt(a[io_, i, j] / RHO)} "
+                            f"{fmt(b[io_, i, j] / (RHO * omega))}\n")
+
+
+def write_excitation(path, omegas, headings_deg, x):
+    """.3: PER BETA I |X| phase Re Im; X = rho g (Re + i Im). x[iw, ib, i]: X in N (N m) per metre of wave
+    amplitude, already in exp(+i w t)."""
+    with open(path, "w") as f:
+        for io_, omega in enumerate(omegas):
+            per = 2 * np.pi / omega
+            for ib, beta in enumerate(headings_deg):
+                for i in range(x.shape[2]):
+                    v = complex(x[io_, ib, i]) / (RHO * G)
+                    f.write(f"{fmt(per)} {fmt(beta)} {i + 1:3d} {fmt(abs(v))} {fmt(np.degrees(np.angle(v)))} "
+                            f"{fmt(v.real)} {fmt(v.imag)}\n")
+
+
+def write_hst(path, cmat):
+    """.hst: I J Cbar, C = rho g Cbar"""
+    with open(path, "w") as f:
+        for i in range(cmat.shape[0]):
+            for j in range(cmat.shape[1]):
                 f.write(f"{i + 1:3d} {j + 1:3d} {fmt(cmat[i, j] / (RHO * G))}\n")
-    # Capytaine's own RAO, exp(+i w t)
-    with open(os.path.join(args.outdir, "capytaine_rao.csv"), "w") as f:
+
+
+def write_rao_csv(path, omegas, headings_deg, r):
+    """Capytaine's own RAO, r[iw, ib, i] already in exp(+i w t)."""
+    with open(path, "w") as f:
         f.write("omega,heading_deg,mode,amplitude,phase_deg\n")
-        r = rao.transpose("omega", "wave_direction", "radiating_dof").values
         for io_, omega in enumerate(omegas):
-            for ib, beta in zip(rao_index, rao_headings):
-                for i in range(nmodes):
-                    x = np.conj(complex(r[io_, ib, i]))
+            for ib, beta in enumerate(headings_deg):
+                for i in range(r.shape[2]):
+                    x = complex(r[io_, ib, i])
                     f.write(f"{omega:.6g},{beta:.6g},{i + 1},{abs(x):.9e},{np.degrees(np.angle(x)):.6f}\n")
-    # system.toml
-    with open(os.path.join(args.outdir, "system.toml"), "w") as f:
-        f.write(f"# shipcast system file, written by tools/bem/make_db.py --preset {args.preset}\n")
+
+
+def write_system_toml(path, preset, stem, built, p, roll_b44):
+    with open(path, "w") as f:
+        f.write(f"# shipcast system file, written by tools/bem/make_db.py --preset {preset}\n")
         f.write(f"# Capytaine {cpt.__version__}; conventions: shipcast DESIGN.md section 1\n")
-        f.write(f'wamit = "{p["stem"]}"\nulen = 1.0\nrho = {RHO}\ng = {G}\nwater_depth = "infinite"\n')
+        f.write(f'wamit = "{stem}"\nulen = 1.0\nrho = {RHO}\ng = {G}\nwater_depth = "infinite"\n')
         f.write("hydrodynamic_coupling = true\n")
         for (body, mass, cog, _), spec in zip(built, p["bodies"]):
             pos = np.array(spec["position"], dtype=float)
@@ -493,10 +554,13 @@ def main():
             f.write(f'\n[[point]]\nname = "{name}"\nbody = "{body}"\nposition_m = [{at[0]}, {at[1]}, {at[2]}]\n')
         for name, a, b in p.get("relative_motions", []):
             f.write(f'\n[[relative_motion]]\nname = "{name}"\npoint_a = "{a}"\npoint_b = "{b}"\n')
-    # Passivity of the (symmetrized) damping: the smallest eigenvalue of B(w), raw (relative to the largest
-    # |eigenvalue| at that frequency) and in coordinates scaled by sqrt(max_w B_ii) as shipcast's
-    # hydro::radiation::passive_damping does (translations and rotations weigh alike).
-    bmat = np.asarray(ds["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof").values)
+
+
+def damping_passivity(bmat, omegas, label=""):
+    """Passivity of the damping: the smallest eigenvalue of the symmetric part of B(w), raw (relative to the
+    largest |eigenvalue| at that frequency) and in coordinates scaled by sqrt(max_w B_ii) as shipcast's
+    hydro::radiation::passive_damping does (translations and rotations weigh alike). bmat[iw, i, j]."""
+    nmodes = bmat.shape[1]
     peaks = np.array([np.abs(bmat[:, i, i]).max() for i in range(nmodes)])
     sc = np.sqrt(np.where(peaks > 1e-9 * peaks.max(), peaks, np.inf))
     indefinite, lowest_scaled, lowest_at = [], 0.0, None
@@ -506,17 +570,21 @@ def main():
         scaled = np.linalg.eigvalsh(bs / np.outer(sc, sc))
         if scaled.min() < -1e-3:
             indefinite.append(float(omega))
-            print(f"B indefinite at omega = {omega:.4g}: min eigenvalue {raw.min() / np.abs(raw).max():+.4f} of the "
-                  f"largest |eigenvalue|, scaled {scaled.min():+.4f}", flush=True)
+            print(f"{label}B indefinite at omega = {omega:.4g}: min eigenvalue {raw.min() / np.abs(raw).max():+.4f} of "
+                  f"the largest |eigenvalue|, scaled {scaled.min():+.4f}", flush=True)
         if scaled.min() < lowest_scaled:
             lowest_scaled, lowest_at = float(scaled.min()), float(omega)
-    # natural periods of heave, roll and pitch: the lowest frequency in the data with C_ii = w^2 (M_ii + A_ii(w))
+    return indefinite, lowest_scaled, lowest_at
+
+
+def natural_periods(bodies, a_diag, omegas, mmat, cmat, label=""):
+    """Natural periods of heave, roll and pitch: the lowest frequency in the data with C_ii = w^2 (M_ii + A_ii(w))."""
     natural = []
     for k in range(len(bodies)):
         periods = {}
         for j, name in ((2, "heave"), (3, "roll"), (4, "pitch")):
             i = 6 * k + j
-            am = np.asarray(ds["added_mass"].sel(radiating_dof=dof_names[i], influenced_dof=dof_names[i]).values)
+            am = a_diag[:, i]
             res = cmat[i, i] - omegas**2 * (mmat[i, i] + am)
             cross = np.nonzero((res[:-1] > 0) & (res[1:] <= 0))[0]
             if len(cross) == 0:
@@ -525,8 +593,89 @@ def main():
             n = cross[0]
             w = omegas[n] + (omegas[n + 1] - omegas[n]) * res[n] / (res[n] - res[n + 1])
             periods[name] = float(2 * np.pi / w)
-            print(f"{bodies[k].name}: {name} natural period {2 * np.pi / w:.3f} s ({w:.4f} rad/s)", flush=True)
+            print(f"{label}{bodies[k].name}: {name} natural period {2 * np.pi / w:.3f} s ({w:.4f} rad/s)", flush=True)
         natural.append(periods)
+    return natural
+
+
+def speed_system_files(outdir, stem0, speed_set, direct):
+    """Completes OUTDIR/system.toml with the speed set (shipcast's `[[database]]` entries: speed_m_s and
+    wamit, ascending speeds; `wamit` stays the zero-speed set), and writes for each set solved directly
+    at a speed outside the set a system file `<stem>.toml` of the same bodies naming it alone (what the
+    interpolation in speed is checked against)."""
+    path = os.path.join(outdir, "system.toml")
+    with open(path) as f:
+        text = f.read()
+    for stem in direct:
+        with open(os.path.join(outdir, f"{stem}.toml"), "w") as f:
+            f.write(text.replace(f'wamit = "{stem0}"', f'wamit = "{stem}"', 1))
+    with open(path, "a") as f:
+        f.write("\n# databases at forward speeds: A and B against the encounter frequency, X against the wave\n"
+                "# frequency (bem_info.toml `convention`); shipcast interpolates between them\n")
+        for stem, speed in sorted(speed_set, key=lambda s: s[1]):
+            f.write(f'\n[[database]]\nspeed_m_s = {speed:.1f}\nwamit = "{stem}"\n')
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--preset", choices=sorted(PRESETS), required=True)
+    ap.add_argument("outdir")
+    args = ap.parse_args()
+    p = PRESETS[args.preset]
+    os.makedirs(args.outdir, exist_ok=True)
+    if "speeds" in p:
+        return main_speeds(args, p)
+    t0 = time.time()
+    omegas = np.asarray(p["omegas"], dtype=float)
+    omega_max = float(omegas.max())
+    built, bodies, system, dof_names = build_system(p)
+    nmodes = len(dof_names)
+    solver, bem_method, gf_singularities = make_solver(p)
+
+    # The database's headings (the .3 file) and the headings of Capytaine's RAO (capytaine_rao.csv; a preset's
+    # `rao_headings_deg`, by default the database's): the diffraction problems are solved at both.
+    db_headings = np.asarray(p["headings_deg"], dtype=float)
+    rao_headings = np.asarray(p.get("rao_headings_deg", db_headings), dtype=float)
+    solved_headings = np.unique(np.round(np.concatenate([db_headings, rao_headings]), 9))
+    db_index = [int(np.argmin(np.abs(solved_headings - h))) for h in db_headings]
+    rao_index = [int(np.argmin(np.abs(solved_headings - h))) for h in rao_headings]
+    headings_rad = np.radians(solved_headings)
+    test = xr.Dataset(coords={"omega": omegas, "wave_direction": headings_rad,
+                              "radiating_dof": dof_names, "water_depth": [np.inf], "rho": [RHO], "g": [G]})
+    ds = solver.fill_dataset(test, system, progress_bar=False)
+    # infinite-frequency and zero-frequency added mass (radiation only)
+    limits = xr.Dataset(coords={"omega": [0.0, np.inf], "radiating_dof": dof_names, "water_depth": [np.inf],
+                                "rho": [RHO], "g": [G]})
+    ds_lim = solver.fill_dataset(limits, system, progress_bar=False)
+    t_solve = time.time() - t0
+    asym = symmetrize(ds, ("added_mass", "radiation_damping"), dof_names)
+    asym.update(symmetrize(ds_lim, ("added_mass",), dof_names, "_limits"))
+
+    mmat = np.asarray(system.inertia_matrix)
+    cmat = np.asarray(system.hydrostatic_stiffness)
+    ds["inertia_matrix"] = system.inertia_matrix
+    ds["hydrostatic_stiffness"] = system.hydrostatic_stiffness
+    a_w = np.asarray(ds["added_mass"].transpose("omega", "influenced_dof", "radiating_dof").values)
+    b_w = np.asarray(ds["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof").values)
+    a_diag = np.diagonal(a_w, axis1=1, axis2=2)
+    dissipation, roll_b44 = roll_damping(a_diag, omegas, mmat, cmat, p["bodies"])
+    rao = cpt.post_pro.rao(ds, dissipation=system.add_dofs_labels_to_matrix(dissipation))
+
+    stem = os.path.join(args.outdir, p["stem"])
+    lim_a = ds_lim["added_mass"].transpose("omega", "influenced_dof", "radiating_dof", ...)
+    lim_rows = [(per, np.asarray(lim_a.sel(omega=omega).values).reshape(nmodes, nmodes))
+                for omega, per in ((0.0, -1.0), (np.inf, 0.0))]
+    write_radiation(stem + ".1", omegas, a_w, b_w, lim_rows)
+    # excitation in exp(+i w t): conjugate Capytaine's value
+    exc = np.conj(np.asarray(ds["excitation_force"].transpose("omega", "wave_direction", "influenced_dof").values))
+    write_excitation(stem + ".3", omegas, db_headings, exc[:, db_index, :])
+    write_hst(stem + ".hst", cmat)
+    # Capytaine's own RAO, exp(+i w t)
+    r = np.conj(np.asarray(rao.transpose("omega", "wave_direction", "radiating_dof").values))
+    write_rao_csv(os.path.join(args.outdir, "capytaine_rao.csv"), omegas, rao_headings, r[:, rao_index, :])
+    write_system_toml(os.path.join(args.outdir, "system.toml"), args.preset, p["stem"], built, p, roll_b44)
+    indefinite, lowest_scaled, lowest_at = damping_passivity(b_w, omegas)
+    natural = natural_periods(bodies, a_diag, omegas, mmat, cmat)
     with open(os.path.join(args.outdir, "bem_info.toml"), "w") as f:
         f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
         f.write(f'command = "python3 tools/bem/make_db.py --preset {args.preset} {args.outdir}"\n')
@@ -559,6 +708,221 @@ def main():
         v = np.asarray(bd.sel(radiating_dof=name, influenced_dof=name).values)
         if (v < -1e-6 * max(1.0, np.abs(v).max())).any():
             print(f"WARNING: negative damping on {name} at omega = {omegas[v < 0]}", file=sys.stderr)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Forward speed (a preset with `speeds`): see SPEED_CONVENTION
+
+SPEED_CONVENTION = __doc__[__doc__.index("One WAMIT file set per forward speed"):].rstrip()
+
+
+def diffraction_problem(body, omega, beta_rad, speed):
+    """Capytaine's DiffractionProblem, with the incident wave's normal velocity on the hull corrected where
+    the Doppler-shifted frequency w - k U cos beta is negative. There Capytaine 3.0.0 solves at |w_e| with
+    the wave turned by 180 deg (encounter_wave_direction = beta + pi): airy_waves_pressure (the Froude-Krylov
+    pressure, rho g exp(-i k x.d) e^{kz}) is then the complex conjugate of the true incident wave's, as it
+    should be, but airy_waves_velocity keeps the vertical component -i (g k / w) exp(-i k x.d) e^{kz}, where
+    the conjugate wave has +i: the diffraction boundary condition is wrong (measured on the barge at 4 m/s in
+    following seas, 2.40-2.50 rad/s: heave and pitch X jumped by 10 % and 40 % across w_e = 0; with this
+    correction they are continuous). Set the boundary condition to -(conj(v_I) . n), v_I the incident velocity at zero
+    speed (the same w, k and beta)."""
+    pb = cpt.DiffractionProblem(body=body, omega=omega, wave_direction=beta_rad, forward_speed=speed,
+                                water_depth=np.inf, rho=RHO, g=G)
+    if speed != 0.0 and pb.encounter_wave_direction != pb.wave_direction:
+        still = cpt.DiffractionProblem(body=body, omega=omega, wave_direction=beta_rad, water_depth=np.inf,
+                                       rho=RHO, g=G)
+        v = np.conj(airy_waves_velocity(body.mesh.faces_centers, still))
+        pb.boundary_condition[body.hull_mask] = -(v * body.mesh.faces_normals).sum(axis=1)
+    return pb
+
+
+def solve_in_order(solver, problems):
+    """solve_all, results in the order of `problems` (solve_all groups them), failures raised."""
+    results = solver.solve_all(problems, progress_bar=False)
+    by_id = {id(r.problem): r for r in results}
+    out = [by_id[id(pb)] for pb in problems]
+    for r in out:
+        if hasattr(r, "exception"):
+            raise RuntimeError(f"{r.problem}: {r.exception}")
+    return out
+
+
+def excitation_of(result):
+    """Capytaine's excitation (diffraction + Froude-Krylov) of a diffraction result, per influenced dof."""
+    return {rec["influenced_dof"]: rec["diffraction_force"] + rec["Froude_Krylov_force"] for rec in result.records}
+
+
+def main_speeds(args, p):
+    t0 = time.time()
+    outdir = args.outdir
+    omegas = np.asarray(p["omegas"], dtype=float)
+    db_headings = np.asarray(p["headings_deg"], dtype=float)
+    built, bodies, system, dof_names = build_system(p)
+    if len(bodies) != 1:
+        raise ValueError("forward speed: Capytaine 3.0.0 implements it for a single rigid body only")
+    nmodes = len(dof_names)
+    solver, bem_method, gf_singularities = make_solver(p)
+    if bem_method != "indirect":
+        raise ValueError("forward speed: Capytaine's direct method does not solve problems with forward speed")
+    mmat = np.asarray(system.inertia_matrix)
+    cmat = np.asarray(system.hydrostatic_stiffness)
+    speeds = p["speeds"]
+    rao_heads = {stem: np.asarray(h, dtype=float) for stem, h in p.get("rao_headings_deg", {}).items()}
+    sets = {}
+
+    # zero speed: as the other presets (fill_dataset; A and B symmetrized; Capytaine's RAO)
+    stem0, u0, _ = next(s for s in speeds if s[1] == 0.0)
+    rao0 = rao_heads.get(stem0, np.zeros(0))
+    solved0 = np.unique(np.round(np.concatenate([db_headings, rao0]), 9))
+    db_index = [int(np.argmin(np.abs(solved0 - h))) for h in db_headings]
+    rao0_index = [int(np.argmin(np.abs(solved0 - h))) for h in rao0]
+    test = xr.Dataset(coords={"omega": omegas, "wave_direction": np.radians(solved0), "radiating_dof": dof_names,
+                              "water_depth": [np.inf], "rho": [RHO], "g": [G]})
+    ds = solver.fill_dataset(test, system, progress_bar=False)
+    ds_lim = solver.fill_dataset(xr.Dataset(coords={"omega": [0.0, np.inf], "radiating_dof": dof_names,
+                                                    "water_depth": [np.inf], "rho": [RHO], "g": [G]}),
+                                 system, progress_bar=False)
+    asym0 = symmetrize(ds, ("added_mass", "radiation_damping"), dof_names)
+    asym0.update(symmetrize(ds_lim, ("added_mass",), dof_names, "_limits"))
+    ds["inertia_matrix"] = system.inertia_matrix
+    ds["hydrostatic_stiffness"] = system.hydrostatic_stiffness
+    a_w = np.asarray(ds["added_mass"].transpose("omega", "influenced_dof", "radiating_dof").values)
+    b_w = np.asarray(ds["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof").values)
+    dissipation, roll_b44 = roll_damping(np.diagonal(a_w, axis1=1, axis2=2), omegas, mmat, cmat, p["bodies"])
+    lim_a = ds_lim["added_mass"].transpose("omega", "influenced_dof", "radiating_dof", ...)
+    a_zero = np.asarray(lim_a.sel(omega=0.0).values).reshape(nmodes, nmodes)
+    a_inf = np.asarray(lim_a.sel(omega=np.inf).values).reshape(nmodes, nmodes)
+    exc = np.conj(np.asarray(ds["excitation_force"].transpose("omega", "wave_direction", "influenced_dof").values))
+    rao = None
+    if len(rao0):
+        r = cpt.post_pro.rao(ds, dissipation=system.add_dofs_labels_to_matrix(dissipation))
+        rao = np.conj(np.asarray(r.transpose("omega", "wave_direction", "radiating_dof").values))[:, rao0_index, :]
+    sets[stem0] = dict(speed=0.0, a=a_w, b=b_w, x=exc[:, db_index, :], limits=[(-1.0, a_zero), (0.0, a_inf)],
+                       asym={f"{k}": v for k, v in asym0.items()}, symmetrized=True, rao=rao, rao_headings=rao0,
+                       negative_encounter=[], seconds=time.time() - t0)
+    print(f"{stem0}: U = 0 m/s solved in {sets[stem0]['seconds']:.1f} s", flush=True)
+
+    beta90 = np.radians(90.0)
+    for stem, speed, _ in speeds:
+        if speed == 0.0:
+            continue
+        t1 = time.time()
+        # radiation on the grid of encounter frequencies: w = w_e at beta = 90 deg
+        rad_pbs = [cpt.RadiationProblem(body=system, omega=we, wave_direction=beta90, forward_speed=speed,
+                                        radiating_dof=d, water_depth=np.inf, rho=RHO, g=G)
+                   for we in omegas for d in dof_names]
+        rheads = rao_heads.get(stem, np.zeros(0))
+        solved = np.unique(np.round(np.concatenate([db_headings, rheads]), 9))
+        diff_pbs = [diffraction_problem(system, w, np.radians(h), speed) for w in omegas for h in solved]
+        # Capytaine's RAO at speed takes A and B at (w, beta) (fill_dataset's radiation problems at speed):
+        # the radiation problems at the RAO's headings other than 90 deg (90 deg: the encounter grid's)
+        rao_rad_heads = [h for h in rheads if not np.isclose(h, 90.0)]
+        rao_pbs = [cpt.RadiationProblem(body=system, omega=w, wave_direction=np.radians(h), forward_speed=speed,
+                                        radiating_dof=d, water_depth=np.inf, rho=RHO, g=G)
+                   for w in omegas for h in rao_rad_heads for d in dof_names]
+        rad = solve_in_order(solver, rad_pbs)
+        diff = solve_in_order(solver, diff_pbs)
+        rao_rad = solve_in_order(solver, rao_pbs) if rao_pbs else []
+        a = np.zeros((len(omegas), nmodes, nmodes))
+        b = np.zeros((len(omegas), nmodes, nmodes))
+        for io_, we in enumerate(omegas):
+            for j, dj in enumerate(dof_names):
+                res = rad[io_ * nmodes + j]
+                assert res.radiating_dof == dj and np.isclose(res.encounter_omega, we, rtol=1e-12)
+                for i, di in enumerate(dof_names):
+                    a[io_, i, j] = res.added_mass[di]
+                    b[io_, i, j] = res.radiation_damping[di]
+        x = np.zeros((len(omegas), len(solved), nmodes), dtype=complex)
+        negative = []
+        for io_, w in enumerate(omegas):
+            for ib, h in enumerate(solved):
+                res = diff[io_ * len(solved) + ib]
+                f = excitation_of(res)
+                v = np.array([f[d] for d in dof_names])
+                if res.encounter_wave_direction != res.wave_direction:
+                    negative.append((float(w), float(h), float(-res.encounter_omega)))
+                    x[io_, ib] = v          # solved at |w_e| with the conjugate wave: already exp(+i w_e' t)
+                else:
+                    x[io_, ib] = np.conj(v)
+        if not (np.isfinite(a).all() and np.isfinite(b).all() and np.isfinite(x).all()):
+            raise RuntimeError(f"{stem}: NaN in Capytaine's results (zero encounter frequency?)")
+        db_idx = [int(np.argmin(np.abs(solved - h))) for h in db_headings]
+        rao = None
+        if len(rheads):
+            # Capytaine's own RAO machinery (post_pro.rao uses the dataset's encounter_omega)
+            keep = set(np.round(rheads, 9))
+            rad90 = rad if any(np.isclose(rheads, 90.0)) else []
+            diff_r = [r for r in diff if round(float(np.degrees(r.wave_direction)), 9) in keep]
+            dsr = cpt.assemble_dataset(rad90 + rao_rad + diff_r, hydrostatics=False)
+            dsr["inertia_matrix"] = system.inertia_matrix
+            dsr["hydrostatic_stiffness"] = system.hydrostatic_stiffness
+            r = cpt.post_pro.rao(dsr, dissipation=system.add_dofs_labels_to_matrix(dissipation))
+            r = r.squeeze(drop=True).transpose("omega", "wave_direction", "radiating_dof")
+            assert np.allclose(r["wave_direction"].values, np.radians(rheads))
+            rao = np.conj(np.asarray(r.values))
+        sets[stem] = dict(speed=speed, a=a, b=b, x=x[:, db_idx, :], limits=[(0.0, a_inf)],
+                          asym={"added_mass": asymmetry(a), "radiation_damping": asymmetry(b)}, symmetrized=False,
+                          rao=rao, rao_headings=rheads, negative_encounter=negative, seconds=time.time() - t1)
+        print(f"{stem}: U = {speed:g} m/s solved in {sets[stem]['seconds']:.1f} s ({len(rad_pbs)} radiation, "
+              f"{len(diff_pbs)} diffraction, {len(rao_pbs)} RAO radiation problems); "
+              f"{len(negative)} (w, beta) with negative encounter frequency", flush=True)
+    t_solve = time.time() - t0
+
+    for stem, s in sets.items():
+        path = os.path.join(outdir, stem)
+        write_radiation(path + ".1", omegas, s["a"], s["b"], s["limits"])
+        write_excitation(path + ".3", omegas, db_headings, s["x"])
+        write_hst(path + ".hst", cmat)
+        if s["rao"] is not None:
+            name = "capytaine_rao.csv" if s["speed"] == 0.0 else f"capytaine_rao_{stem.split('_')[-1]}.csv"
+            s["rao_file"] = name
+            write_rao_csv(os.path.join(outdir, name), omegas, s["rao_headings"], s["rao"])
+        s["passivity"] = damping_passivity(s["b"], omegas, label=f"{stem}: ")
+        s["natural"] = natural_periods(bodies, np.diagonal(s["a"], axis1=1, axis2=2), omegas, mmat, cmat,
+                                       label=f"{stem}: ")
+    write_system_toml(os.path.join(outdir, "system.toml"), args.preset, stem0, built, p, roll_b44)
+    speed_system_files(outdir, stem0, [(stem, speed) for stem, speed, in_set in speeds if in_set],
+                       [stem for stem, _, in_set in speeds if not in_set])
+    with open(os.path.join(outdir, "bem_info.toml"), "w") as f:
+        f.write(f'capytaine_version = "{cpt.__version__}"\npreset = "{args.preset}"\n')
+        f.write(f'command = "python3 tools/bem/make_db.py --preset {args.preset} {outdir}"\n')
+        f.write(f"solve_seconds = {t_solve:.1f}\n")
+        f.write(f'bem_method = "{bem_method}"\ngf_singularities = "{gf_singularities}"\n')
+        f.write(f"n_omega = {len(omegas)}\nomega_min = {omegas.min()}\nomega_max = {omegas.max()}   "
+                f"# the .3's wave frequencies; the .1's encounter frequencies (U != 0) on the same grid\n")
+        f.write(f"headings_deg = {list(map(float, db_headings))}\n")
+        f.write(f'lid = "{p.get("lid", "lowest")}"\n')
+        f.write(f'convention = """\n{SPEED_CONVENTION}\n"""\n')
+        body, _, _, z_lid = built[0]
+        f.write(f'[panels.{body.name}]\nhull = {body.mesh.nb_faces}\nlid = {0 if z_lid is None else body.lid_mesh.nb_faces}\n')
+        if z_lid is not None:
+            f.write(f"lid_z = {z_lid:.6f}\n")
+        for stem, s in sets.items():
+            indefinite, lowest_scaled, lowest_at = s["passivity"]
+            f.write(f'\n[[database]]\nwamit = "{stem}"\nspeed_m_s = {s["speed"]:.1f}\n')
+            f.write(f"solve_seconds = {s['seconds']:.1f}\n")
+            what = "before symmetrizing" if s["symmetrized"] else "as written (not symmetrized: physical at speed)"
+            for key, worst in s["asym"].items():
+                f.write(f"asymmetry_{key} = {worst:.6f}   # largest |X_ij - X_ji| / sqrt(X_ii X_jj), {what}\n")
+            if s["speed"] != 0.0:
+                # the encounter frequencies the .3's (w, beta) need, against the .1's grid
+                k = omegas**2 / G
+                we = np.abs(omegas[:, None] - k[:, None] * s["speed"] * np.cos(np.radians(db_headings))[None, :])
+                f.write(f"encounter_omega_needed = [{we.min():.4f}, {we.max():.4f}]   # |w - k U cos beta| over "
+                        f"the .3's grid; the .1 covers [{omegas.min()}, {omegas.max()}]\n")
+                f.write(f"negative_encounter = {[[w, h, round(e, 5)] for w, h, e in s['negative_encounter']]}"
+                        f"   # [w, beta_deg, w - k U cos beta] written unconjugated\n")
+            if s["rao"] is not None:
+                f.write(f'rao_file = "{s["rao_file"]}"\nrao_headings_deg = {list(map(float, s["rao_headings"]))}\n')
+            f.write(f"damping_indefinite_omegas = {[float(w) for w in indefinite]}   # symmetric part of B(w), "
+                    f"scaled: an eigenvalue below -1e-3\n")
+            f.write(f"damping_lowest_scaled_eigenvalue = {lowest_scaled:.6f}"
+                    + ("\n" if lowest_at is None else f"   # at omega = {lowest_at}\n"))
+            for bname, periods in zip([b.name for b in bodies], s["natural"]):
+                f.write(f"natural_periods_s = {{ {', '.join(f'{n} = ' + ('nan' if t is None else f'{t:.4f}') for n, t in periods.items())} }}"
+                        f"   # {bname}: C_ii = w_e^2 (M_ii + A_ii(w_e)), lowest root in the data\n")
+    print(f"done in {time.time() - t0:.1f} s: {len(sets)} speeds, {len(omegas)} frequencies, "
+          f"{len(db_headings)} database headings, {nmodes} modes", flush=True)
 
 
 if __name__ == "__main__":
