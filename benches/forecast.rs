@@ -1,12 +1,13 @@
 //! One 300 s forecast of the one-ship demo (6 DOF) and the two-ship demo (12 DOF, full 12x12 coupling,
 //! every DOF active), both radiation methods, 240 wave components in a short-crested JONSWAP sea
 //! (config/scenarios/two-ship.toml's sea), after a 600 s simulated history; and one integrator step.
-//! Setup (loading, fitting, the spin-up) is outside the timing.
+//! The two-ship state-space forecast also underway: 3 m/s and turning at 0.2 deg/s from t0 (the wave
+//! force in pieces of 2 deg of heading). Setup (loading, fitting, the spin-up) is outside the timing.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::files::load_system;
 use shipcast::rom::stepper::Stepper;
-use shipcast::rom::{Forecaster, RadiationMethod, RomOptions, TimeModel};
+use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel, Track};
 use shipcast::scenario::{Prepared, Scenario, past_options, prepare};
 use std::hint::black_box;
 use std::path::Path;
@@ -40,6 +41,18 @@ fn benches(c: &mut Criterion) {
             g.bench_function(format!("{name}_{mname}"), |b| {
                 b.iter(|| fc.forecast(&model, black_box(&req)).map(|f| f.steps).unwrap())
             });
+            if name == "two_ship_12dof" && method == RadiationMethod::StateSpace {
+                let turning = ForecastRequest {
+                    track: Some(Track {
+                        turn_rate_rad_s: 0.2f64.to_radians(),
+                        ..Track::straight(3.0)
+                    }),
+                    ..req
+                };
+                g.bench_function(format!("{name}_{mname}_turning_3m_s"), |b| {
+                    b.iter(|| fc.forecast(&model, black_box(&turning)).map(|f| f.steps).unwrap())
+                });
+            }
             if name == "two_ship_12dof" {
                 // one step of the integrator (state space), from the prepared state
                 let mut st = Stepper::new();

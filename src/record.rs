@@ -28,6 +28,9 @@
 //!   "sog_m_s", "cog_deg", "stw_m_s", "rot_deg_s", "valid"}` (as on the wire: compass degrees,
 //!   rate of turn positive to starboard; absent from logs before version 3)
 //! - `/tick` (`shipcast.Tick`): `{"clock_s"}`, a cadence tick of a recording daemon
+//! - `/elevation` (`foxglove.Grid`): a radar scan as the daemon received it on `<prefix>/elevation`
+//!   (frame `earth`, the grid's corner and turn in `pose`, one FLOAT32 field `elevation_m`, NaN where a
+//!   cell is not valid); replay inverts the scans as the daemon does
 //! - `/radar` (`foxglove.Grid`, Foxglove's well-known schema): the simulated radar's elevation snapshot
 //!   (frame `earth`: x east, y north, m; one FLOAT32 field `elevation_m`, 0 outside the disc), one per
 //!   `simulate.radar.record_grid_every` scans; replay does not read it
@@ -45,7 +48,7 @@ use std::path::Path;
 
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
 /// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
-/// `/radar`; 3: `/navigation`.
+/// `/radar`; 3: `/navigation`, `/elevation`.
 pub const LOG_SCHEMA_VERSION: u32 = 3;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
@@ -318,7 +321,7 @@ impl RotatingRecorder {
 pub type Error = Box<dyn std::error::Error + Send + Sync>;
 
 /// The channels: topic, schema name, schema (JSON Schema of the record type).
-fn topics() -> [(&'static str, &'static str, schemars::Schema); 7] {
+fn topics() -> [(&'static str, &'static str, schemars::Schema); 8] {
     use schemars::schema_for;
     [
         ("/motion", "shipcast.Motion", schema_for!(MotionRecord)),
@@ -328,6 +331,7 @@ fn topics() -> [(&'static str, &'static str, schemars::Schema); 7] {
         ("/forecast", "shipcast.Forecast", schema_for!(ForecastRecord)),
         ("/tick", "shipcast.Tick", schema_for!(TickRecord)),
         ("/radar", "foxglove.Grid", schema_for!(GridRecord)),
+        ("/elevation", "foxglove.Grid", schema_for!(GridRecord)),
     ]
 }
 
@@ -445,6 +449,78 @@ const FOXGLOVE_FLOAT32: u32 = 7;
 impl GridRecord {
     /// A grid of elevations (m) at cell centres `x_m` (east) by `y_m` (north), row-major by y, stamped
     /// `time_s` (UNIX seconds); the cells are stored as little-endian f32 (a picture, not an input).
+    /// A radar scan (its grid's corner and turn in `pose`; NaN cells kept).
+    pub fn of_scan(scan: &crate::ipc::Scan) -> GridRecord {
+        let g = &scan.grid;
+        let local: Vec<f64> = g.x_m.iter().map(|x| x - g.x_m[0]).collect();
+        let mut r = GridRecord::elevation(
+            &local,
+            &g.y_m.iter().map(|y| y - g.y_m[0]).collect::<Vec<_>>(),
+            &g.values,
+            g.time_s,
+        );
+        let corner = scan
+            .frame
+            .to_earth(g.x_m[0] - 0.5 * r.cell_size.x, g.y_m[0] - 0.5 * r.cell_size.y);
+        let half = 0.5 * scan.frame.orientation_rad;
+        r.pose = FoxglovePose {
+            position: FoxgloveVector3 {
+                x: corner[0],
+                y: corner[1],
+                z: 0.0,
+            },
+            orientation: FoxgloveQuaternion {
+                x: 0.0,
+                y: 0.0,
+                z: half.sin(),
+                w: half.cos(),
+            },
+        };
+        r
+    }
+
+    /// The scan of a `/elevation` record (the inverse of [`Self::of_scan`]): one FLOAT32 field, a turn
+    /// about z only.
+    pub fn scan(&self) -> Result<crate::ipc::Scan, String> {
+        use base64::Engine;
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(&self.data)
+            .map_err(|e| format!("elevation grid data: {e}"))?;
+        let nx = self.column_count as usize;
+        if nx < 4 || self.cell_stride != 4 || self.row_stride as usize != 4 * nx || bytes.len() % (4 * nx) != 0 {
+            return Err(format!(
+                "elevation grid of {nx} columns, cell stride {}, row stride {}, {} bytes: one FLOAT32 per cell expected",
+                self.cell_stride,
+                self.row_stride,
+                bytes.len()
+            ));
+        }
+        let ny = bytes.len() / (4 * nx);
+        let q = &self.pose.orientation;
+        let theta = 2.0 * q.z.atan2(q.w);
+        let (dx, dy) = (self.cell_size.x, self.cell_size.y);
+        let frame = crate::waves::observe::GridFrame {
+            origin_m: [self.pose.position.x, self.pose.position.y],
+            orientation_rad: theta,
+        };
+        let origin = frame.to_earth(0.5 * dx, 0.5 * dy);
+        Ok(crate::ipc::Scan {
+            grid: crate::waves::observe::Grid {
+                x_m: (0..nx).map(|i| i as f64 * dx).collect(),
+                y_m: (0..ny).map(|i| i as f64 * dy).collect(),
+                time_s: self.timestamp.sec as f64 + self.timestamp.nsec as f64 * 1e-9,
+                values: bytes
+                    .chunks_exact(4)
+                    .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
+                    .collect(),
+            },
+            frame: crate::waves::observe::GridFrame {
+                origin_m: origin,
+                orientation_rad: theta,
+            },
+        })
+    }
+
     pub fn elevation(x_m: &[f64], y_m: &[f64], values: &[f64], time_s: f64) -> GridRecord {
         use base64::Engine;
         let dx = if x_m.len() > 1 { x_m[1] - x_m[0] } else { 1.0 };
@@ -584,6 +660,7 @@ impl<W: Write + Seek> Recorder<W> {
         match r {
             Record::Motion(m) => self.write("/motion", t, m),
             Record::Navigation(n) => self.write("/navigation", t, n),
+            Record::Elevation(g) => self.write("/elevation", t, g),
             Record::Waves(w) => self.write("/waves", t, w),
             Record::Truth(m) => self.write("/truth", t, m),
             Record::Forecast(f) => self.write("/forecast", t, f),
@@ -623,6 +700,8 @@ impl<W: Write + Seek> Recorder<W> {
 pub enum Record {
     Motion(MotionRecord),
     Navigation(NavigationRecord),
+    /// A radar scan (`/elevation`).
+    Elevation(Box<GridRecord>),
     Waves(WavesRecord),
     Truth(MotionRecord),
     Forecast(ForecastRecord),
@@ -680,6 +759,7 @@ pub fn read(path: &Path) -> Result<Read, Error> {
         let rec = match m.channel.topic.as_str() {
             "/motion" => serde_json::from_slice(&m.data).map(Record::Motion),
             "/navigation" => serde_json::from_slice(&m.data).map(Record::Navigation),
+            "/elevation" => serde_json::from_slice(&m.data).map(|g| Record::Elevation(Box::new(g))),
             "/truth" => serde_json::from_slice(&m.data).map(Record::Truth),
             "/waves" => serde_json::from_slice(&m.data).map(Record::Waves),
             "/forecast" => serde_json::from_slice(&m.data).map(Record::Forecast),

@@ -14,7 +14,7 @@
 use crate::hydro::VesselSystem;
 use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel, Track};
 use crate::waves::field::{Region, WaveField};
-use crate::waves::observe::{Grid, GridOptions, from_grids};
+use crate::waves::observe::{Grid, GridFrame, GridOptions, from_grids};
 use crate::waves::sea::{SeaState, realize_all};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -39,6 +39,10 @@ pub struct RadarSpec {
     /// Frequency band the processor keeps, rad/s.
     pub omega_min_rad_s: f64,
     pub omega_max_rad_s: f64,
+    /// No echo within this range of the antenna, m (0: none).
+    pub blind_radius_m: f64,
+    /// A sector the superstructure masks: relative bearings from, to (deg clockwise from the bow).
+    pub masked_sector_deg: Option<(f64, f64)>,
 }
 
 /// The motion sensors.
@@ -163,12 +167,7 @@ impl Simulation {
             .clone();
         Ok(Simulation {
             n_bodies: sys.spec.bodies.len(),
-            body_xy_m: sys
-                .spec
-                .bodies
-                .iter()
-                .map(|b| [b.position_m.x, b.position_m.y])
-                .collect(),
+            body_xy_m: sys.spec.reference_points_xy_m(),
             map_centre_m: None,
             rng: ChaCha8Rng::seed_from_u64(spec.seed ^ 0x5eed),
             sea,
@@ -289,9 +288,23 @@ impl Simulation {
         }
         let mut values = vec![0.0; pts.len()];
         self.sea.elevation(&pts, t_s, &mut values);
+        // cells the radar does not see are NaN: beyond its range, in its blind zone, in the sector
+        // the superstructure masks (relative bearings clockwise from the bow, seen from the ship)
+        let (heading, ship) = self.pose(t_s);
         for (p, v) in pts.iter().zip(values.iter_mut()) {
-            if (p[0] - o[0]).hypot(p[1] - o[1]) > r.radius_m {
-                *v = 0.0;
+            let range = (p[0] - o[0]).hypot(p[1] - o[1]);
+            let masked = r.masked_sector_deg.is_some_and(|(from, to)| {
+                let (dx, dy) = (p[0] - ship[0], p[1] - ship[1]);
+                let bearing = (heading - dy.atan2(dx)).to_degrees().rem_euclid(360.0);
+                let (from, to) = (from.rem_euclid(360.0), to.rem_euclid(360.0));
+                if from <= to {
+                    (from..=to).contains(&bearing)
+                } else {
+                    bearing >= from || bearing <= to
+                }
+            });
+            if range > r.radius_m || range < r.blind_radius_m || masked {
+                *v = f64::NAN;
             } else {
                 *v += r.noise_m * gauss(&mut self.rng);
             }
@@ -319,9 +332,36 @@ impl Simulation {
                 radius_m: r.radius_m,
             }),
         };
-        from_grids(&self.grids, &opts)
+        // the processor's own inversion: the cells it does not see taken as zero
+        let zeroed: Vec<Grid> = self.grids.iter().map(zero_invalid).collect();
+        from_grids(&zeroed, &opts)
             .ok()
             .map(|f| f.pruned(PROCESSOR_VARIANCE_KEPT))
+    }
+
+    /// The newest radar scan as a processor that publishes maps sends it: the grid along its axes from
+    /// the corner cell, NaN where the radar does not see, and where the grid lies.
+    pub fn last_scan(&self) -> Option<(Grid, GridFrame)> {
+        let g = self.grids.last()?;
+        Some((
+            Grid {
+                x_m: g.x_m.iter().map(|x| x - g.x_m[0]).collect(),
+                y_m: g.y_m.iter().map(|y| y - g.y_m[0]).collect(),
+                ..g.clone()
+            },
+            GridFrame {
+                origin_m: [g.x_m[0], g.y_m[0]],
+                orientation_rad: 0.0,
+            },
+        ))
+    }
+}
+
+/// A grid with its NaN cells (not seen) set to zero.
+pub fn zero_invalid(g: &Grid) -> Grid {
+    Grid {
+        values: g.values.iter().map(|v| if v.is_finite() { *v } else { 0.0 }).collect(),
+        ..g.clone()
     }
 }
 

@@ -154,8 +154,24 @@ fn at(t: &[f64], rows: &[Vec<f64>], time: f64, col: usize) -> Option<f64> {
 
 #[test]
 fn forecasts_over_iceoryx2_match_the_simulated_truth() {
-    let dir = crate::util::scratch_dir("daemon-e2e");
-    let cfg = config(&dir, "e2e", "");
+    forecasts_match_the_truth("e2e", "");
+}
+
+/// Underway over iceoryx2 (issue 25): the simulator's radar publishes its scans on `/elevation` (the
+/// daemon inverts them) and its navigation on `/navigation`, the ship at 3 m/s turning at 0.2 deg/s.
+#[test]
+fn forecasts_over_iceoryx2_from_radar_scans_underway_match_the_simulated_truth() {
+    forecasts_match_the_truth(
+        "e2e-underway",
+        "output = \"grid\"\n[simulate.track]\nspeed_m_s = 3.0\nturn_deg_s = 0.2\n",
+    );
+}
+
+/// The one-ship demo with `extra` (TOML appended after `[simulate.radar]`'s keys) live over iceoryx2:
+/// heave and pitch at 30 s lead against the simulator's truth.
+fn forecasts_match_the_truth(name: &str, extra: &str) {
+    let dir = crate::util::scratch_dir(&format!("daemon-{name}"));
+    let cfg = config(&dir, name, extra);
     let truth_path = dir.join("truth.csv");
     let _daemon = daemon(&cfg);
     let _sim = simulator(&cfg, "240", &["--truth", truth_path.to_str().unwrap()]);
@@ -168,6 +184,19 @@ fn forecasts_over_iceoryx2_match_the_simulated_truth() {
     let (t, rows) = truth(&truth_path);
     let t_start = t[0];
     let (mut fh, mut th, mut fp, mut tp) = (vec![], vec![], vec![], vec![]);
+    // the simulator publishes navigation: after its first fixes no forecast falls back to [site]
+    let fallback = forecasts
+        .iter()
+        .filter(|f| f["issue_time_s"].as_f64().unwrap() - t_start > 10.0)
+        .filter(|f| {
+            f["flags"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|n| n == "navigation_fallback")
+        })
+        .count();
+    assert_eq!(fallback, 0, "{fallback} forecasts flagged navigation_fallback");
     for f in &forecasts {
         let t0 = f["issue_time_s"].as_f64().unwrap();
         // after the ramp and a full memory of history

@@ -399,3 +399,127 @@ fn the_two_ship_demo_underway_without_navigation_flags_every_forecast() {
         .count();
     assert_eq!(flagged, fs.len());
 }
+
+// ---- radar grids ----
+
+/// Three scans of a 128 x 128 grid over 2 km of a long-crested sea travelling east, with the cells
+/// `masked` (east, north of the centre) says the radar does not see set to NaN.
+fn scans(masked: impl Fn(f64, f64) -> bool) -> Vec<shipcast::waves::observe::Grid> {
+    use shipcast::waves::sea::{SeaState, Spreading, realize_all};
+    let sea = SeaState {
+        hs_m: 2.0,
+        tp_s: 9.0,
+        gamma: 3.3,
+        heading_rad: 0.0,
+        spreading: Spreading::LongCrested,
+        components: 100,
+        omega_min_rad_s: 0.3,
+        omega_max_rad_s: 1.4,
+        seed: 11,
+    };
+    let field = WaveField::from_components(&realize_all(&[sea]), 9.81, None, Region::Everywhere);
+    let n = 128;
+    let d = 2000.0 / n as f64;
+    let xs: Vec<f64> = (0..n).map(|i| -1000.0 + (i as f64 + 0.5) * d).collect();
+    (0..3)
+        .map(|s| {
+            let t = 2.0 * s as f64;
+            let mut values = vec![0.0; n * n];
+            for (iy, y) in xs.iter().enumerate() {
+                for (ix, x) in xs.iter().enumerate() {
+                    let inside = x.hypot(*y) <= 1000.0 && !masked(*x, *y);
+                    values[iy * n + ix] = if inside {
+                        field.elevation_at([*x, *y], t)
+                    } else {
+                        f64::NAN
+                    };
+                }
+            }
+            shipcast::waves::observe::Grid {
+                x_m: xs.iter().map(|x| x - xs[0]).collect(),
+                y_m: xs.iter().map(|y| y - xs[0]).collect(),
+                time_s: t,
+                values,
+            }
+        })
+        .collect()
+}
+
+fn scan_horizon(masked: impl Fn(f64, f64) -> bool) -> f64 {
+    use shipcast::waves::observe::{GridFrame, GridOptions, from_scans};
+    let grids = scans(masked);
+    let frame = GridFrame {
+        origin_m: [-1000.0 + 2000.0 / 256.0, -1000.0 + 2000.0 / 256.0],
+        orientation_rad: 0.0,
+    };
+    let opts = GridOptions {
+        g_m_s2: 9.81,
+        depth_m: None,
+        omega_min_rad_s: 0.25,
+        omega_max_rad_s: 1.5,
+        mean_direction_rad: None,
+        region: None,
+    };
+    let f = from_scans(&grids, frame, &opts).unwrap();
+    assert!(matches!(f.region, Region::Coverage { .. }));
+    horizon::of_field(&f, [0.0, 0.0], [0.0, 0.0], 0.0).horizon_s
+}
+
+/// A sector the superstructure masks on the side the waves come from (west: they travel east) halves
+/// the reach there; on the side they go to it changes little.
+#[test]
+fn a_masked_sector_shortens_the_horizon_for_waves_from_that_side() {
+    let full = scan_horizon(|_, _| false);
+    // relative to the centre: the sector within 45 deg of west, beyond 150 m (a superstructure's shadow)
+    let west = scan_horizon(|x, y| x < 0.0 && y.abs() < -x && x.hypot(y) > 150.0);
+    let east = scan_horizon(|x, y| x > 0.0 && y.abs() < x && x.hypot(y) > 150.0);
+    eprintln!("scan horizons: whole disc {full:.1} s, west (up-wave) masked {west:.1} s, east masked {east:.1} s");
+    assert!(west < 0.5 * full, "{west} against {full}");
+    assert!((east - full).abs() < 0.1 * full, "{east} against {full}");
+}
+
+/// The same sea as radar scans (`simulate.radar.output = "grid"`, inverted by the daemon) and as the
+/// simulated processor's components: heave and pitch correlation at 30 s lead within this of each
+/// other (both inversions see the same cells; the daemon's keeps the database's band, the
+/// processor's the sea's).
+const GRID_SKILL_MARGIN: f64 = 0.02;
+
+#[test]
+fn a_log_of_radar_scans_replays_with_the_skill_of_its_components() {
+    let mut skill = vec![];
+    for output in ["components", "grid"] {
+        let log = simulated_with(
+            &format!("underway-radar-{output}"),
+            "one-ship.toml",
+            "vessels/ship/system.toml",
+            300.0,
+            &[("[simulate.radar]", &format!("[simulate.radar]\noutput = \"{output}\""))],
+        );
+        let has = |topic: fn(&Record) -> bool| log.records.iter().any(|(_, r)| topic(r));
+        assert_eq!(has(|r| matches!(r, Record::Elevation(_))), output == "grid");
+        assert_eq!(has(|r| matches!(r, Record::Waves(_))), output == "components");
+        let fs = replayed(&log, &log.records);
+        assert!(fs.len() > 250, "{output}: {} forecasts", fs.len());
+        let heave = correlation(&log, &fs, 0, 2, 60.0, 300.0);
+        let pitch = correlation(&log, &fs, 0, 4, 60.0, 300.0);
+        let horizon = fs.iter().map(|(h, _)| h.horizon_s[0]).sum::<f64>() / fs.len() as f64;
+        eprintln!(
+            "{output}: heave correlation at {LEAD_S} s lead {:.3}, pitch {:.3} ({} forecasts), mean horizon {horizon:.1} s",
+            heave.0, pitch.0, heave.1
+        );
+        skill.push((heave.0, pitch.0));
+    }
+    let (c, g) = (skill[0], skill[1]);
+    assert!(
+        g.0 >= c.0 - GRID_SKILL_MARGIN,
+        "heave: grid {} against components {}",
+        g.0,
+        c.0
+    );
+    assert!(
+        g.1 >= c.1 - GRID_SKILL_MARGIN,
+        "pitch: grid {} against components {}",
+        g.1,
+        c.1
+    );
+}

@@ -115,6 +115,8 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
             snapshots: s.radar.snapshots,
             omega_min_rad_s: 0.8 * s.sea.omega_min_rad_s,
             omega_max_rad_s: 1.1 * s.sea.omega_max_rad_s,
+            blind_radius_m: s.radar.blind_radius_m,
+            masked_sector_deg: s.radar.masked_sector_deg.map(|m| (m[0], m[1])),
         },
         imu: ImuSpec {
             rate_hz: s.imu.rate_hz,
@@ -201,6 +203,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     let nav_dt = if nav_rate > 0.0 { 1.0 / nav_rate } else { f64::INFINITY };
     let mut next_nav = 0.0f64;
     let grid_every = cfg.simulate.radar.record_grid_every;
+    let grid_output = cfg.simulate.radar.output == "grid";
     let mut scans = 0u64;
     let start = Instant::now();
     let speed = cfg.simulate.speed;
@@ -236,7 +239,13 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
                 std::thread::sleep(wait);
             }
             if next_radar <= next_imu {
-                if let Some(mut f) = sim.radar(t) {
+                let field = sim.radar(t);
+                if grid_output {
+                    if let Some(scan) = scan_of(&sim, epoch) {
+                        p.elevation(&scan)
+                            .map_err(|e| anyhow::anyhow!("publishing elevation: {e}"))?;
+                    }
+                } else if let Some(mut f) = field {
                     f.time_s += epoch;
                     p.waves(&f).map_err(|e| anyhow::anyhow!("publishing waves: {e}"))?;
                 }
@@ -251,7 +260,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         } else if let Some(rec) = recorder.as_mut() {
             let radar = next_radar <= next_imu;
             let at = a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
-            record_step(rec, &mut sim, t, epoch, radar, (grid_every, &mut scans))
+            record_step(rec, &mut sim, t, epoch, radar, (grid_every, &mut scans), grid_output)
                 .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
             if radar {
                 next_radar += radar_dt;
@@ -293,6 +302,7 @@ fn record_step(
     epoch: f64,
     radar: bool,
     (grid_every, scans): (u32, &mut u64),
+    grid_output: bool,
 ) -> std::result::Result<(), shipcast::record::Error> {
     use shipcast::record::{GridRecord, MotionRecord, WavesRecord};
     if radar {
@@ -305,7 +315,11 @@ fn record_step(
             rec.write("/radar", t + epoch, &grid)?;
         }
         *scans += 1;
-        if let Some(mut f) = field {
+        if grid_output {
+            if let Some(scan) = scan_of(sim, epoch) {
+                rec.write("/elevation", t + epoch, &GridRecord::of_scan(&scan))?;
+            }
+        } else if let Some(mut f) = field {
             f.time_s += epoch;
             rec.write("/waves", t + epoch, &WavesRecord::of(&f))?;
         }
@@ -339,6 +353,13 @@ fn record_step(
         )?;
     }
     Ok(())
+}
+
+/// The simulator's newest radar scan on the data clock (`simulate.radar.output = "grid"`).
+fn scan_of(sim: &Simulation, epoch: f64) -> Option<shipcast::ipc::Scan> {
+    let (mut grid, frame) = sim.last_scan()?;
+    grid.time_s += epoch;
+    Some(shipcast::ipc::Scan { grid, frame })
 }
 
 /// Sets `flag` on SIGINT/SIGTERM (the simulator is not async).

@@ -156,7 +156,9 @@ pub fn run(args: &RaoArgs) -> Result<()> {
                 speed_m_s: args.speed,
                 ..RomOptions::default()
             };
-            let model = TimeModel::new(sys, flag_checked(opts)?).with_context(context)?;
+            // a system with databases at several speeds: the one at this speed
+            let at = sys.at_speed(args.speed).with_context(context)?;
+            let model = TimeModel::new(&at, flag_checked(opts)?).with_context(context)?;
             let mut table = vec![];
             for &h in &headings_deg {
                 let r = time_domain_rao(&model, h.to_radians(), &omegas, RegularOptions::default())

@@ -225,6 +225,11 @@ impl SystemSpec {
         6 * self.bodies.len()
     }
 
+    /// Each body's reference point (x, y) in the system's frame, m.
+    pub fn reference_points_xy_m(&self) -> Vec<[f64; 2]> {
+        self.bodies.iter().map(|b| [b.position_m.x, b.position_m.y]).collect()
+    }
+
     /// Parses and validates a system file's text; `file` labels errors.
     pub fn from_toml(text: &str, file: &str) -> Result<SystemSpec> {
         let raw: SystemFile = toml::from_str(text).map_err(|e| {
@@ -572,12 +577,7 @@ impl VesselSystem {
         if !self.spec.hydrodynamic_coupling {
             db.decouple();
         }
-        let origins: Vec<[f64; 2]> = self
-            .spec
-            .bodies
-            .iter()
-            .map(|b| [b.position_m.x, b.position_m.y])
-            .collect();
+        let origins = self.spec.reference_points_xy_m();
         db.set_bodies(
             &origins,
             self.spec.g_m_s2,
@@ -639,7 +639,7 @@ impl VesselSystem {
         if !spec.hydrodynamic_coupling {
             db.decouple();
         }
-        let origins: Vec<[f64; 2]> = spec.bodies.iter().map(|b| [b.position_m.x, b.position_m.y]).collect();
+        let origins = spec.reference_points_xy_m();
         db.set_bodies(&origins, spec.g_m_s2, spec.water_depth_m, spec.port_starboard_symmetric)
             .map_err(|msg| Error::Key {
                 file: file.into(),

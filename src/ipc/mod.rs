@@ -75,6 +75,7 @@ fn event(
 }
 
 type SliceService<H> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [f64], H>;
+type F32Service<H> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [f32], H>;
 type FixedService<T> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
 
 fn motion_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<MotionSample>> {
@@ -91,6 +92,15 @@ fn navigation_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedS
         .publish_subscribe::<NavigationSample>()
         .subscriber_max_buffer_size(BUFFER)
         .max_publishers(8)
+        .open_or_create()
+        .map_err(err)
+}
+
+fn elevation_service(node: &Node<ipc::Service>, names: &Names) -> Result<F32Service<ElevationHeader>> {
+    node.service_builder(&names.name("elevation")?)
+        .publish_subscribe::<[f32]>()
+        .user_header::<ElevationHeader>()
+        .subscriber_max_buffer_size(8)
         .open_or_create()
         .map_err(err)
 }
@@ -144,11 +154,91 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
     WaveField::from_flat(h.flat(), rows).map_err(|e| format!("wave field: {e}"))
 }
 
+/// A radar scan decoded from the wire: the grid (its axes' coordinates from the frame's origin; NaN
+/// cells invalid) and where it lies.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scan {
+    pub grid: crate::waves::observe::Grid,
+    pub frame: crate::waves::observe::GridFrame,
+}
+
+/// A radar scan from the wire, its header checked against its payload.
+pub fn decode_elevation(h: &ElevationHeader, payload: &[f32]) -> std::result::Result<Scan, String> {
+    if h.schema_version != SCHEMA_VERSION {
+        return Err(format!(
+            "elevation scan of schema version {} (this shipcast reads {SCHEMA_VERSION})",
+            h.schema_version
+        ));
+    }
+    if !(4..=MAX_GRID_CELLS).contains(&h.n_x) || !(4..=MAX_GRID_CELLS).contains(&h.n_y) {
+        return Err(format!(
+            "elevation scan of {} x {} cells: 4..={MAX_GRID_CELLS} along each axis",
+            h.n_x, h.n_y
+        ));
+    }
+    if payload.len() != (h.n_x * h.n_y) as usize {
+        return Err(format!(
+            "elevation scan: {} values for {} x {} cells",
+            payload.len(),
+            h.n_x,
+            h.n_y
+        ));
+    }
+    let numbers = [h.time_s, h.origin_east_m, h.origin_north_m, h.orientation_deg];
+    if numbers.iter().any(|v| !v.is_finite())
+        || !(h.spacing_x_m.is_finite() && h.spacing_x_m > 0.0 && h.spacing_y_m.is_finite() && h.spacing_y_m > 0.0)
+    {
+        return Err(format!(
+            "elevation scan with time {} s, origin ({}, {}) m, spacing {} x {} m, orientation {} deg: finite, spacing positive",
+            h.time_s, h.origin_east_m, h.origin_north_m, h.spacing_x_m, h.spacing_y_m, h.orientation_deg
+        ));
+    }
+    Ok(Scan {
+        grid: crate::waves::observe::Grid {
+            x_m: (0..h.n_x).map(|i| i as f64 * h.spacing_x_m).collect(),
+            y_m: (0..h.n_y).map(|i| i as f64 * h.spacing_y_m).collect(),
+            time_s: h.time_s,
+            values: payload.iter().map(|v| *v as f64).collect(),
+        },
+        frame: crate::waves::observe::GridFrame {
+            origin_m: [h.origin_east_m, h.origin_north_m],
+            orientation_rad: crate::waves::field::heading_from_compass_deg(h.orientation_deg),
+        },
+    })
+}
+
+/// The wire header and payload of a scan whose grid axes start at 0 (as [`decode_elevation`] gives
+/// them), the inverse of it.
+pub fn encode_elevation(scan: &Scan) -> (ElevationHeader, Vec<f32>) {
+    let g = &scan.grid;
+    let step = |v: &[f64]| if v.len() > 1 { v[1] - v[0] } else { 1.0 };
+    let origin = scan.frame.to_earth(g.x_m[0], g.y_m[0]);
+    (
+        ElevationHeader {
+            schema_version: SCHEMA_VERSION,
+            n_x: g.x_m.len() as u32,
+            n_y: g.y_m.len() as u32,
+            reserved: 0,
+            time_s: g.time_s,
+            origin_east_m: origin[0],
+            origin_north_m: origin[1],
+            spacing_x_m: step(&g.x_m),
+            spacing_y_m: step(&g.y_m),
+            orientation_deg: (90.0 - scan.frame.orientation_rad.to_degrees()).rem_euclid(360.0),
+        },
+        g.values.iter().map(|v| *v as f32).collect(),
+    )
+}
+
 /// What the input thread forwards.
 #[derive(Debug, Clone)]
+// a wave field (its region included) a scan period: a box would be an allocation for nothing
+#[allow(clippy::large_enum_variant)]
 pub enum Input {
     Motion(MotionSample),
     Navigation(NavigationSample),
+    /// A radar scan (boxed: a scan is up to 4 MB).
+    Elevation(Box<Scan>),
     Waves(WaveField),
     /// A sample that could not be decoded (counted, logged).
     Rejected(String),
@@ -183,9 +273,14 @@ pub fn spawn_input(
                 let (_, motion_l) = event(&node, &names, "motion")?;
                 let (_, waves_l) = event(&node, &names, "waves")?;
                 let (_, nav_l) = event(&node, &names, "navigation")?;
-                Ok((node, (motion, nav, waves), (motion_l, nav_l, waves_l)))
+                let elev = elevation_service(&node, &names)?
+                    .subscriber_builder()
+                    .create()
+                    .map_err(err)?;
+                let (_, elev_l) = event(&node, &names, "elevation")?;
+                Ok((node, (motion, nav, waves, elev), (motion_l, nav_l, waves_l, elev_l)))
             };
-            let (node, (motion, nav, waves), (motion_l, nav_l, waves_l)) = match setup() {
+            let (node, (motion, nav, waves, elev), (motion_l, nav_l, waves_l, elev_l)) = match setup() {
                 Ok(s) => {
                     let _ = ready.send(Ok(()));
                     s
@@ -203,10 +298,11 @@ pub fn spawn_input(
                     return;
                 }
             };
-            let (Ok(_g1), Ok(_g2), Ok(_g3), Ok(_g4)) = (
+            let (Ok(_g1), Ok(_g2), Ok(_g3), Ok(_g4), Ok(_g5)) = (
                 ws.attach_notification(&motion_l),
                 ws.attach_notification(&waves_l),
                 ws.attach_notification(&nav_l),
+                ws.attach_notification(&elev_l),
                 ws.attach_interval(STOP_CHECK),
             ) else {
                 tracing::error!("input thread: cannot attach to the waitset");
@@ -214,11 +310,22 @@ pub fn spawn_input(
             };
             let drain = |motion: &Subscriber<ipc::Service, MotionSample, ()>,
                          nav: &Subscriber<ipc::Service, NavigationSample, ()>,
-                         waves: &Subscriber<ipc::Service, [f64], WaveHeader>|
+                         waves: &Subscriber<ipc::Service, [f64], WaveHeader>,
+                         elev: &Subscriber<ipc::Service, [f32], ElevationHeader>|
              -> bool {
                 let _ = motion_l.try_wait(|_| {});
                 let _ = waves_l.try_wait(|_| {});
                 let _ = nav_l.try_wait(|_| {});
+                let _ = elev_l.try_wait(|_| {});
+                while let Ok(Some(s)) = elev.receive() {
+                    let msg = match decode_elevation(s.user_header(), s.payload()) {
+                        Ok(scan) => Input::Elevation(Box::new(scan)),
+                        Err(e) => Input::Rejected(e),
+                    };
+                    if tx.blocking_send(msg).is_err() {
+                        return false;
+                    }
+                }
                 while let Ok(Some(s)) = motion.receive() {
                     if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
                         return false;
@@ -241,7 +348,7 @@ pub fn spawn_input(
                 true
             };
             // whatever was there before we attached (history of the waves service)
-            if !drain(&motion, &nav, &waves) {
+            if !drain(&motion, &nav, &waves, &elev) {
                 return;
             }
             loop {
@@ -250,7 +357,7 @@ pub fn spawn_input(
                 }
                 let mut alive = true;
                 let r = ws.wait_and_process_once(|_| {
-                    alive = drain(&motion, &nav, &waves);
+                    alive = drain(&motion, &nav, &waves, &elev);
                     CallbackProgression::Stop
                 });
                 if r.is_err() || !alive {
@@ -336,6 +443,8 @@ pub struct SensorPublisher {
     motion: Publisher<ipc::Service, MotionSample, ()>,
     nav: Publisher<ipc::Service, NavigationSample, ()>,
     nav_n: Notifier<ipc::Service>,
+    elev: Publisher<ipc::Service, [f32], ElevationHeader>,
+    elev_n: Notifier<ipc::Service>,
     waves: Publisher<ipc::Service, [f64], WaveHeader>,
     motion_n: Notifier<ipc::Service>,
     waves_n: Notifier<ipc::Service>,
@@ -361,11 +470,20 @@ impl SensorPublisher {
         let (motion_n, _) = event(&node, names, "motion")?;
         let (waves_n, _) = event(&node, names, "waves")?;
         let (nav_n, _) = event(&node, names, "navigation")?;
+        let elev = elevation_service(&node, names)?
+            .publisher_builder()
+            .initial_max_slice_len(128 * 128)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(err)?;
+        let (elev_n, _) = event(&node, names, "elevation")?;
         Ok(SensorPublisher {
             _node: node,
             motion,
             nav,
             nav_n,
+            elev,
+            elev_n,
             waves,
             motion_n,
             waves_n,
@@ -391,6 +509,16 @@ impl SensorPublisher {
             .send()
             .map_err(err)?;
         self.nav_n.notify().map_err(err)?;
+        Ok(())
+    }
+
+    pub fn elevation(&self, scan: &Scan) -> Result<()> {
+        let (h, values) = encode_elevation(scan);
+        let s = self.elev.loan_slice_uninit(values.len()).map_err(err)?;
+        let mut s = s.write_from_slice(&values);
+        *s.user_header_mut() = h;
+        s.send().map_err(err)?;
+        self.elev_n.notify().map_err(err)?;
         Ok(())
     }
 
@@ -519,5 +647,59 @@ impl MotionSubscriber {
             out.push(*s.payload());
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::waves::observe::{Grid, GridFrame};
+
+    fn scan() -> Scan {
+        Scan {
+            grid: Grid {
+                x_m: (0..6).map(|i| 10.0 * i as f64).collect(),
+                y_m: (0..5).map(|i| 12.0 * i as f64).collect(),
+                time_s: 1.75e9 + 0.25,
+                values: (0..30)
+                    .map(|i| if i == 7 { f64::NAN } else { 0.1 * i as f64 })
+                    .collect(),
+            },
+            frame: GridFrame {
+                origin_m: [100.0, -40.0],
+                orientation_rad: 0.3,
+            },
+        }
+    }
+
+    #[test]
+    fn a_scan_goes_over_the_wire_and_into_a_log_and_back() {
+        let s = scan();
+        let (h, v) = encode_elevation(&s);
+        let back = decode_elevation(&h, &v).unwrap();
+        assert_eq!(back.grid.x_m, s.grid.x_m);
+        assert!((back.frame.orientation_rad - 0.3).abs() < 1e-12);
+        assert!(back.grid.values[7].is_nan() && (back.grid.values[8] - 0.8).abs() < 1e-6);
+        let rec = crate::record::GridRecord::of_scan(&s).scan().unwrap();
+        assert!((rec.frame.origin_m[0] - 100.0).abs() < 1e-9 && (rec.frame.origin_m[1] + 40.0).abs() < 1e-9);
+        assert!((rec.frame.orientation_rad - 0.3).abs() < 1e-12);
+        assert_eq!(rec.grid.y_m, s.grid.y_m);
+        assert!((rec.grid.time_s - s.grid.time_s).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_scan_whose_header_does_not_fit_its_payload_is_refused() {
+        let (h, v) = encode_elevation(&scan());
+        assert!(decode_elevation(&h, &v[..29]).unwrap_err().contains("29 values"));
+        let bad = [
+            ElevationHeader { n_x: 2, ..h },
+            ElevationHeader { n_x: 5000, ..h },
+            ElevationHeader { spacing_x_m: 0.0, ..h },
+            ElevationHeader { time_s: f64::NAN, ..h },
+            ElevationHeader { schema_version: 9, ..h },
+        ];
+        for b in bad {
+            assert!(decode_elevation(&b, &v).is_err(), "{b:?}");
+        }
     }
 }

@@ -11,6 +11,9 @@
 //! notified after every send):
 //! - `motion`: [`MotionSample`], one per IMU sample, any vessel.
 //! - `navigation`: [`NavigationSample`], one per GNSS/gyro fix, any vessel (its own rate, 1-10 Hz).
+//! - `elevation`: a slice of f32 with an [`ElevationHeader`]: one radar scan, `n_x * n_y` elevations (m)
+//!   row by row (`values[iy * n_x + ix]`), NaN where the cell is not valid (blind zone, shadow, a
+//!   masked sector, beyond the range). The daemon inverts a sequence of scans into a field itself.
 //! - `waves`: a slice of f64 with a [`WaveHeader`]: 4 values per component: omega (rad/s), direction
 //!   (rad, earth), Re and Im of the complex amplitude (m) at the header's reference point and time.
 //! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
@@ -168,6 +171,31 @@ pub mod nav_valid {
     /// `rot_deg_s` is given.
     pub const ROT: u32 = 2;
 }
+
+/// Header of a radar elevation scan (the processor's phase-resolved map). 64 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_ElevationHeader_v1")]
+#[repr(C)]
+pub struct ElevationHeader {
+    pub schema_version: u32,
+    /// Cells along the grid's x and y axes.
+    pub n_x: u32,
+    pub n_y: u32,
+    pub reserved: u32,
+    /// Scan time, s (data clock).
+    pub time_s: f64,
+    /// Centre of cell (0, 0) in the site's tangent plane, m east and m north.
+    pub origin_east_m: f64,
+    pub origin_north_m: f64,
+    /// Cell spacing along the grid's x and y axes, m.
+    pub spacing_x_m: f64,
+    pub spacing_y_m: f64,
+    /// Compass direction of the grid's +x axis, deg clockwise from true north (90: x east, y north).
+    pub orientation_deg: f64,
+}
+
+/// The largest radar grid the daemon takes: cells along each axis (a 1024 x 1024 scan is 4 MB).
+pub const MAX_GRID_CELLS: u32 = 1024;
 
 /// Header of a wave-field sample. 64 bytes.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
@@ -420,6 +448,7 @@ mod tests {
     fn layouts_are_what_the_docs_say() {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
+        assert_eq!(std::mem::size_of::<ElevationHeader>(), 64);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
         assert_eq!(std::mem::size_of::<Status>(), 360);

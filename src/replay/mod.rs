@@ -67,12 +67,19 @@ pub fn drive(
             }
             grid = Some((t0, k));
         }
-        if matches!(r, Record::Motion(_) | Record::Waves(_) | Record::Navigation(_)) {
+        if matches!(
+            r,
+            Record::Motion(_) | Record::Waves(_) | Record::Navigation(_) | Record::Elevation(_)
+        ) {
             last_input_s = *t;
         }
         match r {
             Record::Motion(m) => engine.input(Input::Motion(m.to_wire()), *t),
             Record::Navigation(n) => engine.input(Input::Navigation(n.to_wire()), *t),
+            Record::Elevation(g) => match g.scan() {
+                Ok(scan) => engine.input(Input::Elevation(Box::new(scan)), *t),
+                Err(e) => engine.input(Input::Rejected(e), *t),
+            },
             Record::Waves(w) => match w.field() {
                 Ok(f) => engine.input(Input::Waves(f), *t),
                 Err(e) => engine.input(Input::Rejected(e), *t),

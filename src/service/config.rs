@@ -126,6 +126,8 @@ pub struct ForecastConfig {
     pub max_navigation_age_s: f64,
     /// The pose at a forecast's start is a straight line through this much of the newest fixes, s.
     pub navigation_window_s: f64,
+    /// Radar scans (`<prefix>/elevation`) of one grid inverted together into a field.
+    pub radar_snapshots: u32,
 }
 
 impl Default for ForecastConfig {
@@ -150,6 +152,7 @@ impl Default for ForecastConfig {
             max_dropped_wave_share: 0.1,
             max_navigation_age_s: 5.0,
             navigation_window_s: 30.0,
+            radar_snapshots: 3,
         }
     }
 }
@@ -357,6 +360,13 @@ pub struct RadarConfig {
     pub snapshots: usize,
     /// A recording (`simulate --record`) writes one snapshot in this many to `/radar` (0: none).
     pub record_grid_every: u32,
+    /// What the simulated processor publishes: "components" (a wave field on `<prefix>/waves`) or
+    /// "grid" (each scan on `<prefix>/elevation`, inverted by the daemon).
+    pub output: String,
+    /// No echo within this range of the antenna, m.
+    pub blind_radius_m: f64,
+    /// A sector masked by the superstructure: relative bearings [from, to], deg clockwise from the bow.
+    pub masked_sector_deg: Option<[f64; 2]>,
 }
 
 impl Default for RadarConfig {
@@ -368,6 +378,9 @@ impl Default for RadarConfig {
             noise_m: 0.05,
             snapshots: 3,
             record_grid_every: 15,
+            output: "components".into(),
+            blind_radius_m: 0.0,
+            masked_sector_deg: None,
         }
     }
 }
@@ -714,6 +727,8 @@ pub const BOUNDS: &[Bound] = &[
     positive("forecast.max_navigation_age_s", 3600.0, "s"),
     // at least a few fixes, at most ten minutes of a turn
     closed("forecast.navigation_window_s", 1.0, 600.0, "s"),
+    // two tell opposite directions apart; more than a minute of 2 s scans adds nothing
+    closed("forecast.radar_snapshots", 2.0, 32.0, ""),
     // a sensor's noise: beyond these it measures nothing of a ship's motion
     positive("estimator.noise_m", 10.0, "m"),
     positive("estimator.noise_rad", 1.0, "rad"),
@@ -760,6 +775,8 @@ pub const BOUNDS: &[Bound] = &[
     closed("simulate.imu.noise_rad", 0.0, 1.0, "rad"),
     closed("simulate.imu.bias_m", -10.0, 10.0, "m"),
     closed("simulate.imu.bias_rad", -1.0, 1.0, "rad"),
+    // the radar's range at most (simulate.radar.radius_m's bound)
+    closed("simulate.radar.blind_radius_m", 0.0, 20000.0, "m"),
     // rom::model::MAX_SPEED_M_S (50 knots); astern allowed
     closed("simulate.track.speed_m_s", -25.0, 25.0, "m/s"),
     closed("simulate.track.heading_deg", -360.0, 360.0, "deg"),
@@ -810,6 +827,7 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("forecast.max_dropped_wave_share", f.max_dropped_wave_share),
         one("forecast.max_navigation_age_s", f.max_navigation_age_s),
         one("forecast.navigation_window_s", f.navigation_window_s),
+        one("forecast.radar_snapshots", f.radar_snapshots as f64),
         one("estimator.noise_m", c.estimator.noise_m),
         one("estimator.noise_rad", c.estimator.noise_rad),
         one("estimator.velocity_noise_m_s", c.estimator.velocity_noise_m_s),
@@ -848,6 +866,7 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.imu.noise_rad", s.imu.noise_rad),
         one("simulate.imu.bias_m", s.imu.bias_m),
         one("simulate.imu.bias_rad", s.imu.bias_rad),
+        one("simulate.radar.blind_radius_m", s.radar.blind_radius_m),
         one("simulate.track.speed_m_s", s.track.speed_m_s),
         (
             "simulate.track.heading_deg",
@@ -973,6 +992,23 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         return Err((
             "forecast.radiation".into(),
             format!("expected \"convolution\" or \"state-space\", found \"{}\"", f.radiation),
+        ));
+    }
+    if !["components", "grid"].contains(&c.simulate.radar.output.as_str()) {
+        return Err((
+            "simulate.radar.output".into(),
+            format!(
+                "expected \"components\" or \"grid\", found \"{}\"",
+                c.simulate.radar.output
+            ),
+        ));
+    }
+    if let Some(m) = c.simulate.radar.masked_sector_deg
+        && m.iter().any(|v| !(v.is_finite() && v.abs() <= 360.0))
+    {
+        return Err((
+            "simulate.radar.masked_sector_deg".into(),
+            format!("two relative bearings in [-360, 360] deg, found {m:?}"),
         ));
     }
     if !["human", "json"].contains(&c.log.format.as_str()) {

@@ -139,9 +139,12 @@ pub const MODEL_SPEED_STEP_M_S: f64 = 0.25;
 pub struct Computer {
     model: TimeModel,
     /// The system and options to rebuild the model at another speed, when the system file has speed
-    /// terms (`speed_damping` B_U, `speed_restoring` C_UQ); None: one model serves every speed (the
-    /// speed then enters through the encounter frequency only).
+    /// terms (`speed_damping` B_U, `speed_restoring` C_UQ) or databases at several speeds (interpolated:
+    /// `VesselSystem::at_speed`); None: one model serves every speed (the speed then enters through the
+    /// encounter frequency only).
     rebuild: Option<(Box<VesselSystem>, RomOptions)>,
+    /// The speed step a rebuild failed at (not tried again until the speed moves).
+    failed_speed: Option<f64>,
     fc: Forecaster,
     n_bodies: usize,
     /// Forecast length, s.
@@ -152,15 +155,17 @@ pub struct Computer {
 
 impl Computer {
     pub fn new(model: TimeModel, sys: &VesselSystem, cfg: &ShipcastConfig) -> Computer {
-        let speed_terms = sys.spec.bodies.iter().any(|b| {
-            b.speed_damping
-                .iter()
-                .chain(b.speed_restoring.iter())
-                .any(|v| *v != 0.0)
-        });
+        let speed_terms = !sys.speed_dbs.is_empty()
+            || sys.spec.bodies.iter().any(|b| {
+                b.speed_damping
+                    .iter()
+                    .chain(b.speed_restoring.iter())
+                    .any(|v| *v != 0.0)
+            });
         let n_bodies = sys.spec.bodies.len();
         Computer {
             rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
+            failed_speed: None,
             model,
             fc: Forecaster::new(),
             n_bodies,
@@ -170,17 +175,23 @@ impl Computer {
     }
 
     /// The model at the speed a job's track asks for, rebuilt when the system has speed terms and the
-    /// speed moved to another step of [`MODEL_SPEED_STEP_M_S`]. An error keeps the model it had.
+    /// speed moved to another step of [`MODEL_SPEED_STEP_M_S`]. An error (a speed beyond the databases')
+    /// keeps the model it had, and is reported once per speed step.
     fn at_speed(&mut self, track: Option<Track>) -> Result<(), String> {
         let Some((sys, opts)) = &self.rebuild else {
             return Ok(());
         };
         let want = (track.map_or(0.0, |t| t.speed_m_s) / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
-        if (want - self.model.opts.speed_m_s).abs() < 1e-9 {
+        if (want - self.model.opts.speed_m_s).abs() < 1e-9 || self.failed_speed == Some(want) {
             return Ok(());
         }
+        // tried once per speed step: an error is logged once, the model kept
+        self.failed_speed = Some(want);
+        let at = sys
+            .at_speed(want)
+            .map_err(|e| format!("the database at {want} m/s: {e}"))?;
         let model = TimeModel::new(
-            sys,
+            &at,
             RomOptions {
                 speed_m_s: want,
                 ..*opts
@@ -192,6 +203,7 @@ impl Computer {
             "model rebuilt for the forward speed (its speed terms)"
         );
         self.model = model;
+        self.failed_speed = None;
         // its workspace holds the old model's kernel spectra
         self.fc = Forecaster::new();
         Ok(())
@@ -363,6 +375,41 @@ fn judge(
     }
 }
 
+/// A vessel's sample (`what`: a motion sample, a navigation fix) of (schema version, vessel index,
+/// stamp): the schema and the index checked against `clocks` (one per vessel), the stamp judged by
+/// the vessel's clock of that kind. None: refused (counted, logged); else the vessel and whether its
+/// clock stepped.
+fn vessel_sample(
+    c: &mut Counters,
+    clocks: &mut [clock::SourceClock],
+    what: &str,
+    (schema_version, vessel, stamp_s): (u32, u32, f64),
+    clock_s: f64,
+    rules: &clock::ClockRules,
+) -> Option<(usize, bool)> {
+    let b = vessel as usize;
+    if schema_version != SCHEMA_VERSION || b >= clocks.len() {
+        c.rejected += 1;
+        log_count(
+            c.rejected,
+            &format!(
+                "{what} refused: schema version {schema_version} (this daemon reads {SCHEMA_VERSION}), vessel {vessel} of {}",
+                clocks.len()
+            ),
+        );
+        return None;
+    }
+    judge(
+        &mut clocks[b],
+        c,
+        &format!("vessel {b}: {what}"),
+        stamp_s,
+        clock_s,
+        rules,
+    )
+    .map(|stepped| (b, stepped))
+}
+
 /// Flags of events, kept in the state until the next status reports them.
 const ONE_SHOT_FLAGS: u32 = flags::NUMERICAL | flags::CLOCK_STEP | flags::MOTION_IMPLAUSIBLE | flags::MOTION_RESTARTED;
 
@@ -468,6 +515,10 @@ pub struct Engine {
     /// The last pose taken from navigation: (system heading, system origin, vessel velocity over
     /// ground), kept for when navigation goes stale.
     last_frame: Option<(f64, [f64; 2], [f64; 2])>,
+    /// The newest radar scans of one grid (at most `forecast.radar_snapshots`), and how they are
+    /// inverted (the database's frequency band).
+    scans: std::collections::VecDeque<crate::ipc::Scan>,
+    radar_options: crate::waves::observe::GridOptions,
     /// Each vessel's motion estimator (its kept window of samples).
     hist: Vec<Estimator>,
     /// Clock time of each vessel's newest accepted sample.
@@ -509,15 +560,22 @@ impl Engine {
             active: model.active.clone(),
             n_active: model.n(),
             heading,
-            body_xy_m: sys
-                .spec
-                .bodies
-                .iter()
-                .map(|b| [b.position_m.x, b.position_m.y])
-                .collect(),
+            body_xy_m: sys.spec.reference_points_xy_m(),
             nav: vec![navigation::NavTrack::default(); n_bodies],
             nav_clock: vec![clock::SourceClock::default(); n_bodies],
             last_frame: None,
+            scans: std::collections::VecDeque::new(),
+            radar_options: {
+                let (lo, hi) = model.db.omega_range();
+                crate::waves::observe::GridOptions {
+                    g_m_s2: sys.spec.g_m_s2,
+                    depth_m: sys.spec.water_depth_m,
+                    omega_min_rad_s: lo,
+                    omega_max_rad_s: hi,
+                    mean_direction_rad: None,
+                    region: None,
+                }
+            },
             hist: (0..n_bodies)
                 .map(|b| Estimator::new(estimator_spec(cfg, sys, model, b), keep_s))
                 .collect(),
@@ -563,32 +621,15 @@ impl Engine {
         match msg {
             Input::Motion(m) => {
                 c.samples += 1;
-                let b = m.vessel as usize;
-                if m.schema_version != SCHEMA_VERSION || b >= self.n_bodies {
-                    c.rejected += 1;
-                    log_count(
-                        c.rejected,
-                        &format!(
-                            "motion sample refused: schema version {} (this daemon reads {SCHEMA_VERSION}), vessel {} of {}",
-                            m.schema_version, m.vessel, self.n_bodies
-                        ),
-                    );
+                let sample = (m.schema_version, m.vessel, m.time_s);
+                let Some((b, stepped)) =
+                    vessel_sample(c, &mut self.motion_clock, "motion sample", sample, clock_s, &rules)
+                else {
                     return;
-                }
-                match judge(
-                    &mut self.motion_clock[b],
-                    c,
-                    &format!("vessel {b}: motion sample"),
-                    m.time_s,
-                    clock_s,
-                    &rules,
-                ) {
-                    None => return,
-                    Some(false) => {}
-                    Some(true) => {
-                        self.state_flags |= flags::CLOCK_STEP;
-                        self.hist[b].restart();
-                    }
+                };
+                if stepped {
+                    self.state_flags |= flags::CLOCK_STEP;
+                    self.hist[b].restart();
                 }
                 match self.hist[b].push(m.time_s, m.x, m.v) {
                     Ok(taken) => {
@@ -632,32 +673,15 @@ impl Engine {
             }
             Input::Navigation(n) => {
                 c.navigation += 1;
-                let b = n.vessel as usize;
-                if n.schema_version != SCHEMA_VERSION || b >= self.n_bodies {
-                    c.rejected += 1;
-                    log_count(
-                        c.rejected,
-                        &format!(
-                            "navigation fix refused: schema version {} (this daemon reads {SCHEMA_VERSION}), vessel {} of {}",
-                            n.schema_version, n.vessel, self.n_bodies
-                        ),
-                    );
+                let sample = (n.schema_version, n.vessel, n.time_s);
+                let Some((b, stepped)) =
+                    vessel_sample(c, &mut self.nav_clock, "navigation fix", sample, clock_s, &rules)
+                else {
                     return;
-                }
-                match judge(
-                    &mut self.nav_clock[b],
-                    c,
-                    &format!("vessel {b}: navigation fix"),
-                    n.time_s,
-                    clock_s,
-                    &rules,
-                ) {
-                    None => return,
-                    Some(false) => {}
-                    Some(true) => {
-                        self.state_flags |= flags::CLOCK_STEP;
-                        self.nav[b].restart();
-                    }
+                };
+                if stepped {
+                    self.state_flags |= flags::CLOCK_STEP;
+                    self.nav[b].restart();
                 }
                 match self.nav[b].push(&n, self.cfg.navigation_window_s) {
                     Ok(()) => {}
@@ -681,6 +705,54 @@ impl Engine {
                             c.rejected,
                             &format!("vessel {b}: navigation fix refused: its {what} is beyond what a ship does"),
                         );
+                    }
+                }
+            }
+            Input::Elevation(scan) => {
+                c.wave_fields += 1;
+                let Some(stepped) = judge(&mut self.wave_clock, c, "radar scan", scan.grid.time_s, clock_s, &rules)
+                else {
+                    return;
+                };
+                if stepped {
+                    self.state_flags |= flags::CLOCK_STEP;
+                    self.scans.clear();
+                }
+                // a sequence shares one grid at increasing times: another grid starts it again
+                if self.scans.back().is_some_and(|last| {
+                    last.frame != scan.frame
+                        || last.grid.x_m != scan.grid.x_m
+                        || last.grid.y_m != scan.grid.y_m
+                        || last.grid.time_s >= scan.grid.time_s
+                }) {
+                    self.scans.clear();
+                }
+                self.scans.push_back(*scan);
+                while self.scans.len() > self.cfg.radar_snapshots as usize {
+                    self.scans.pop_front();
+                }
+                if self.scans.len() < self.cfg.radar_snapshots as usize {
+                    return;
+                }
+                let grids: Vec<crate::waves::observe::Grid> = self.scans.iter().map(|s| s.grid.clone()).collect();
+                let frame = self
+                    .scans
+                    .back()
+                    .map(|s| s.frame)
+                    .unwrap_or(crate::waves::observe::GridFrame {
+                        origin_m: [0.0, 0.0],
+                        orientation_rad: 0.0,
+                    });
+                match crate::waves::observe::from_scans(&grids, frame, &self.radar_options) {
+                    Ok(f) => {
+                        let f = f.pruned(self.cfg.wave_variance_kept);
+                        if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+                            self.field = Some(f);
+                        }
+                    }
+                    Err(e) => {
+                        c.rejected += 1;
+                        log_count(c.rejected, &format!("radar scans not inverted: {e}"));
                     }
                 }
             }
@@ -1026,6 +1098,11 @@ fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, 
         ),
         Input::Waves(f) => record(recorder, t, Record::Waves(WavesRecord::of(f))),
         Input::Navigation(n) => record(recorder, t, Record::Navigation(crate::record::NavigationRecord::of(n))),
+        Input::Elevation(scan) => record(
+            recorder,
+            t,
+            Record::Elevation(Box::new(crate::record::GridRecord::of_scan(scan))),
+        ),
         Input::Rejected(_) => {}
     }
 }

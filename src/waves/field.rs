@@ -32,6 +32,8 @@ pub struct FieldComponent {
 
 /// Where a field was observed.
 #[derive(Debug, Clone, Copy, PartialEq)]
+// one region a field: a box would be an allocation per field for nothing, and it keeps the type Copy
+#[allow(clippy::large_enum_variant)]
 pub enum Region {
     /// Known everywhere (a synthetic sea, a list of components without a region).
     Everywhere,
@@ -39,6 +41,39 @@ pub enum Region {
     Disc { centre_m: [f64; 2], radius_m: f64 },
     /// A point (a wave probe).
     Point { at_m: [f64; 2] },
+    /// What a radar's valid cells covered, seen from `centre_m` (earth frame): in each of
+    /// [`COVERAGE_SECTORS`] equal sectors of direction (sector j spans j..j+1 times 360 / sectors deg,
+    /// counterclockwise from east), the farthest valid cell, m (0: nothing seen that way). A blind zone
+    /// around the centre does not shorten a sector's reach.
+    Coverage {
+        centre_m: [f64; 2],
+        ranges_m: [f64; COVERAGE_SECTORS],
+    },
+}
+
+/// Sectors of a [`Region::Coverage`] (5 deg each).
+pub const COVERAGE_SECTORS: usize = 72;
+
+impl Region {
+    /// Whether an earth point is inside the observed region (a point region: never).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        match *self {
+            Region::Everywhere => true,
+            Region::Disc { centre_m, radius_m } => (p[0] - centre_m[0]).hypot(p[1] - centre_m[1]) <= radius_m,
+            Region::Point { .. } => false,
+            Region::Coverage { centre_m, ranges_m } => {
+                let (dx, dy) = (p[0] - centre_m[0], p[1] - centre_m[1]);
+                let j = coverage_sector(dy.atan2(dx));
+                dx.hypot(dy) <= ranges_m[j]
+            }
+        }
+    }
+}
+
+/// The [`Region::Coverage`] sector of a direction (rad, counterclockwise from east).
+pub fn coverage_sector(direction_rad: f64) -> usize {
+    let f = direction_rad.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU;
+    ((f * COVERAGE_SECTORS as f64) as usize).min(COVERAGE_SECTORS - 1)
 }
 
 /// A phase-resolved wave field.
@@ -110,6 +145,8 @@ impl WaveField {
             reference_m: self.reference_m,
             radius_m: match self.region {
                 Region::Disc { radius_m, .. } => radius_m,
+                // on the wire and in logs, the disc of its farthest reach
+                Region::Coverage { ranges_m, .. } => ranges_m.iter().fold(0.0, |m, r| m.max(*r)),
                 Region::Point { .. } => -1.0,
                 Region::Everywhere => 0.0,
             },

@@ -52,6 +52,36 @@ fn disc_exit(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> f64 {
     ((-b + disc.sqrt()) / a).max(0.0)
 }
 
+/// Steps of [`coverage_exit`]'s march, m.
+const COVERAGE_STEP_M: f64 = 10.0;
+
+/// Lead time at which the water reaching a vessel at `position` (moving relative to a group at `rel`)
+/// was outside a coverage region at t0: the first t at which `position + rel t` leaves it, marched in
+/// steps of [`COVERAGE_STEP_M`] (0 if the vessel starts outside).
+fn coverage_exit(region: &Region, position: [f64; 2], rel: [f64; 2]) -> f64 {
+    let Region::Coverage { ranges_m, .. } = region else {
+        return 0.0;
+    };
+    if !region.contains(position) {
+        return 0.0;
+    }
+    let speed = rel[0].hypot(rel[1]);
+    if speed <= 0.0 {
+        return f64::INFINITY;
+    }
+    let reach = 2.0 * ranges_m.iter().fold(0.0f64, |m, r| m.max(*r)) + COVERAGE_STEP_M;
+    let dt = COVERAGE_STEP_M / speed;
+    let mut t = 0.0;
+    while t * speed <= reach {
+        let next = t + dt;
+        if !region.contains([position[0] + rel[0] * next, position[1] + rel[1] * next]) {
+            return t;
+        }
+        t = next;
+    }
+    t
+}
+
 /// The horizon from (weight, lead time, omega, direction, c_g) of every part of the field.
 fn quantile(mut parts: Vec<(f64, f64, f64, f64, f64)>, noncausal_s: f64) -> Horizon {
     parts.sort_by(|a, b| a.1.total_cmp(&b.1));
@@ -92,6 +122,7 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
                     radius_m,
                     rel,
                 ),
+                Region::Coverage { .. } => coverage_exit(&field.region, position_m, rel),
                 Region::Point { at_m } => {
                     // a probe: the group reaches the (stationary) vessel after travelling from it
                     let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);

@@ -9,10 +9,16 @@
 //! travelling waves are told apart); with one snapshot the direction is taken from a mean-direction
 //! hint (the half-plane facing it). Bins outside the wavenumber band are left out.
 //!
+//! Radar scans ([`from_scans`]): snapshots whose cells may be invalid (NaN: the blind zone around the
+//! antenna, cells shadowed behind crests, a sector masked by the superstructure, beyond the range),
+//! on a grid that may be turned in the earth frame. Invalid cells are taken as zero (as outside a
+//! radar's disc), and the field's region is what the cells valid in every snapshot covered
+//! ([`Region::Coverage`]).
+//!
 //! Probe: the record's FFT (the seed paper's method), long-crested along a given direction, amplitudes
 //! referred to the probe and the record's last sample.
 
-use super::field::{Error, FieldComponent, Region, Result, WaveField};
+use super::field::{COVERAGE_SECTORS, Error, FieldComponent, Region, Result, WaveField, coverage_sector};
 use num_complex::Complex64;
 use rustfft::FftPlanner;
 use std::f64::consts::PI;
@@ -154,6 +160,111 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
     Ok(f)
 }
 
+/// Where a radar scan's grid lies in the earth frame: its snapshots' `x_m` and `y_m` are along the
+/// grid's own axes from `origin_m` (earth, m), its +x axis turned `orientation_rad` counterclockwise
+/// from east.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridFrame {
+    pub origin_m: [f64; 2],
+    pub orientation_rad: f64,
+}
+
+impl GridFrame {
+    /// The earth point of grid coordinates (x, y).
+    pub fn to_earth(&self, x: f64, y: f64) -> [f64; 2] {
+        let (s, c) = self.orientation_rad.sin_cos();
+        [self.origin_m[0] + c * x - s * y, self.origin_m[1] + s * x + c * y]
+    }
+}
+
+/// A wavenumber bin whose snapshots' phases leave the least-squares separation of the two directions
+/// this ill-conditioned (its determinant at most this share of the largest, n^2) is left out: near
+/// w = pi / (scan period) every scan sees the bin at the same phase, and the fit would amplify the
+/// noise by 1 / sqrt(share) and more (3 scans 2 s apart: the bins within about 0.1 rad/s of 1.57 rad/s).
+pub const SEPARATION_FLOOR: f64 = 0.1;
+
+/// The least share of a scan's cells that must be valid in every snapshot.
+pub const MIN_VALID_SHARE: f64 = 0.05;
+
+/// A field from radar scans with invalid (NaN) cells on a grid in `frame` ([`from_grids`] on the
+/// valid cells, the rest taken as zero; the region what the valid cells covered, seen from the grid's
+/// centre; directions and reference point turned into the earth frame).
+pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Result<WaveField> {
+    let Some(first) = grids.first() else {
+        return Err(Error::Invalid("no radar scan given".into()));
+    };
+    let (nx, ny) = (first.x_m.len(), first.y_m.len());
+    if grids.iter().any(|g| g.values.len() != nx * ny) {
+        return Err(Error::Invalid(format!(
+            "a scan's values do not fill its {nx} x {ny} grid"
+        )));
+    }
+    let valid: Vec<bool> = (0..nx * ny)
+        .map(|i| grids.iter().all(|g| g.values[i].is_finite()))
+        .collect();
+    let share = valid.iter().filter(|v| **v).count() as f64 / (nx * ny).max(1) as f64;
+    if share < MIN_VALID_SHARE {
+        return Err(Error::Invalid(format!(
+            "{:.1} % of the scans' cells are valid in every snapshot: at least {:.0} % are needed",
+            100.0 * share,
+            100.0 * MIN_VALID_SHARE
+        )));
+    }
+    let zeroed: Vec<Grid> = grids
+        .iter()
+        .map(|g| Grid {
+            values: g
+                .values
+                .iter()
+                .zip(&valid)
+                .map(|(v, ok)| if *ok { *v } else { 0.0 })
+                .collect(),
+            ..g.clone()
+        })
+        .collect();
+    let local = from_grids(
+        &zeroed,
+        &GridOptions {
+            mean_direction_rad: opts.mean_direction_rad.map(|d| d - frame.orientation_rad),
+            region: None,
+            ..*opts
+        },
+    )?;
+    // the coverage, seen from the grid's centre
+    let centre_local = local.reference_m;
+    let centre = frame.to_earth(centre_local[0], centre_local[1]);
+    let mut ranges_m = [0.0f64; COVERAGE_SECTORS];
+    for iy in 0..ny {
+        for ix in 0..nx {
+            if !valid[iy * nx + ix] {
+                continue;
+            }
+            let p = frame.to_earth(first.x_m[ix], first.y_m[iy]);
+            let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
+            let j = coverage_sector(dy.atan2(dx));
+            ranges_m[j] = ranges_m[j].max(dx.hypot(dy));
+        }
+    }
+    let f = WaveField {
+        components: local
+            .components
+            .iter()
+            .map(|c| FieldComponent {
+                direction_rad: c.direction_rad + frame.orientation_rad,
+                ..*c
+            })
+            .collect(),
+        reference_m: centre,
+        region: Region::Coverage {
+            centre_m: centre,
+            ranges_m,
+        },
+        ..local
+    };
+    f.validate()?;
+    Ok(f)
+}
+
 /// Every snapshot on the first one's grid, with `nx` x `ny` finite values, at finite increasing times.
 fn check_snapshots(grids: &[Grid], nx: usize, ny: usize) -> Result<()> {
     let first = &grids[0];
@@ -250,8 +361,9 @@ fn separate(
         }
         // [[a11, a12], [conj(a12), a11]] [P, Q] = [b1, b2]
         let det = a11 * a11 - a12.norm_sqr();
-        if det <= 1e-9 * a11 * a11 {
-            // the snapshots sample this frequency at the same phase: no separation possible
+        if det <= SEPARATION_FLOOR * a11 * a11 {
+            // the snapshots sample this frequency at (nearly) the same phase: no separation possible,
+            // and a near-singular fit turns the noise into metres
             return None;
         }
         Some(((b1 * a11 - a12 * b2) / det, (b2 * a11 - a12.conj() * b1) / det))
