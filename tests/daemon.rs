@@ -223,7 +223,7 @@ fn forecasts_match_the_truth(name: &str, extra: &str) {
         shipcast::skill::correlation(&fp, &tp),
     );
     eprintln!(
-        "{} forecasts, {} scored at {LEAD_S} s lead: heave correlation {ch:.3}, pitch {cp:.3}; horizon reported {} s",
+        "{name}: {} forecasts, {} scored at {LEAD_S} s lead: heave correlation {ch:.3}, pitch {cp:.3}; horizon reported {} s",
         forecasts.len(),
         fh.len(),
         forecasts.last().unwrap()["vessels"][0]["horizon_s"]
