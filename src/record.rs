@@ -32,7 +32,8 @@
 //!   (frame `earth`, the grid's corner and turn in `pose`, one FLOAT32 field `elevation_m`, NaN where a
 //!   cell is not valid); replay inverts the scans as the daemon does
 //! - `/radar` (`foxglove.Grid`, Foxglove's well-known schema): the simulated radar's elevation snapshot
-//!   (frame `earth`: x east, y north, m; one FLOAT32 field `elevation_m`, 0 outside the disc), one per
+//!   (frame `earth`: x east, y north, m; one FLOAT32 field `elevation_m`, NaN where the radar does not
+//!   see), one per
 //!   `simulate.radar.record_grid_every` scans; replay does not read it
 //!
 //! Version 1 logs (before JSON Schemas, metadata and `/radar`; the simulator's log times from 0) are
@@ -447,8 +448,6 @@ pub struct FoxglovePackedElementField {
 const FOXGLOVE_FLOAT32: u32 = 7;
 
 impl GridRecord {
-    /// A grid of elevations (m) at cell centres `x_m` (east) by `y_m` (north), row-major by y, stamped
-    /// `time_s` (UNIX seconds); the cells are stored as little-endian f32 (a picture, not an input).
     /// A radar scan (its grid's corner and turn in `pose`; NaN cells kept).
     pub fn of_scan(scan: &crate::ipc::Scan) -> GridRecord {
         let g = &scan.grid;
@@ -521,6 +520,8 @@ impl GridRecord {
         })
     }
 
+    /// A grid of elevations (m) at cell centres `x_m` (east) by `y_m` (north), row-major by y, stamped
+    /// `time_s` (UNIX seconds); the cells are stored as little-endian f32.
     pub fn elevation(x_m: &[f64], y_m: &[f64], values: &[f64], time_s: f64) -> GridRecord {
         use base64::Engine;
         let dx = if x_m.len() > 1 { x_m[1] - x_m[0] } else { 1.0 };

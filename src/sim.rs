@@ -108,9 +108,11 @@ pub struct NavFix {
     pub position_m: [f64; 2],
     /// Heading of the vessel's +x, counterclockwise from east, rad.
     pub heading_rad: f64,
-    /// Speed over ground, m/s, and its course, counterclockwise from east, rad.
+    /// Speed over ground (>= 0), m/s, and its course, counterclockwise from east, rad.
     pub speed_m_s: f64,
     pub course_rad: f64,
+    /// Speed through the water along the heading, m/s (negative astern).
+    pub stw_m_s: f64,
     /// Rate of turn, counterclockwise positive, rad/s.
     pub turn_rate_rad_s: f64,
 }
@@ -143,7 +145,8 @@ pub struct Simulation {
 impl Simulation {
     /// Realizes the sea and computes the true motion (the system's own model, damping scaled).
     pub fn new(sys: &VesselSystem, opts: RomOptions, spec: SimSpec) -> rom::Result<Simulation> {
-        let mut truth_sys = sys.clone();
+        // the database at the track's speed, as the daemon's model takes it
+        let mut truth_sys = sys.at_speed(spec.track.speed_m_s)?;
         for b in truth_sys.spec.bodies.iter_mut() {
             b.linear_damping *= spec.damping_factor;
         }
@@ -249,8 +252,13 @@ impl Simulation {
                     time_s: t_s,
                     position_m: [o[0] + c * x - s * y + noise[0], o[1] + s * x + c * y + noise[1]],
                     heading_rad: h + yaw + noise[2],
-                    speed_m_s: tr.speed_m_s,
-                    course_rad: h,
+                    speed_m_s: tr.speed_m_s.abs(),
+                    course_rad: if tr.speed_m_s < 0.0 {
+                        h + std::f64::consts::PI
+                    } else {
+                        h
+                    },
+                    stw_m_s: tr.speed_m_s,
                     turn_rate_rad_s: rate + self.true_v(t_s, 6 * b + 5),
                 }
             })
@@ -303,7 +311,8 @@ impl Simulation {
                     bearing >= from || bearing <= to
                 }
             });
-            if range > r.radius_m || range < r.blind_radius_m || masked {
+            let from_antenna = (p[0] - ship[0]).hypot(p[1] - ship[1]);
+            if range > r.radius_m || from_antenna < r.blind_radius_m || masked {
                 *v = f64::NAN;
             } else {
                 *v += r.noise_m * gauss(&mut self.rng);

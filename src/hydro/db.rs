@@ -221,10 +221,10 @@ impl HydroDb {
         self.mirrored = true;
     }
 
-    /// Zeroes every 6x6 block coupling two different bodies (`hydrodynamic_coupling = false`).
     /// The database at forward speed `speed_m_s` from databases at several speeds (speed, database;
     /// speeds ascending), all on the same grids and prepared alike (coupling, body referral, symmetry).
-    /// A(w_e) and B(w_e) are quadratic in the speed through the three nearest speeds (Capytaine's
+    /// A(w_e) and B(w_e) are quadratic in the speed through three consecutive speeds around it, the
+    /// farthest of them as near as can be (Capytaine's
     /// forward-speed radiation is exactly quadratic in U at a given encounter frequency; linear between
     /// the two when only two are given); X(w, beta) is linear between the two speeds either side (at a
     /// given wave frequency the encounter frequency moves with U, and a quadratic overshoots as often
@@ -263,6 +263,15 @@ impl HydroDb {
                 )));
             }
         }
+        if dbs.windows(2).any(|w| w[1].0 <= w[0].0 || w[1].0.is_nan()) {
+            return Err(Error::OutOfRange(
+                "the databases' speeds must increase: each speed once".into(),
+            ));
+        }
+        if dbs.len() == 1 {
+            return Ok(base.clone());
+        }
+        let speed_m_s = speed_m_s.clamp(first.0, last.0);
         // the bracketing pair (linear) and the three nearest speeds (quadratic)
         let hi = dbs
             .iter()
@@ -275,15 +284,14 @@ impl HydroDb {
         let quadratic: Vec<(usize, f64)> = if dbs.len() < 3 {
             linear.to_vec()
         } else {
-            // the window of three consecutive speeds around the speed whose middle is nearest it
+            // the window of three consecutive speeds around the speed whose farthest speed is nearest
             let start = (0..=dbs.len() - 3)
                 .filter(|&i| dbs[i].0 <= speed_m_s && speed_m_s <= dbs[i + 2].0)
                 .min_by(|&i, &j| {
-                    (dbs[i + 1].0 - speed_m_s)
-                        .abs()
-                        .total_cmp(&(dbs[j + 1].0 - speed_m_s).abs())
+                    let reach = |i: usize| (speed_m_s - dbs[i].0).max(dbs[i + 2].0 - speed_m_s);
+                    reach(i).total_cmp(&reach(j))
                 })
-                .unwrap_or(0);
+                .unwrap_or(dbs.len() - 3);
             let idx = [start, start + 1, start + 2];
             idx.iter()
                 .map(|&i| {
@@ -310,6 +318,7 @@ impl HydroDb {
         Ok(out)
     }
 
+    /// Zeroes every 6x6 block coupling two different bodies (`hydrodynamic_coupling = false`).
     pub fn decouple(&mut self) {
         let mask = |m: &mut DMatrix<f64>| {
             for i in 0..m.nrows() {

@@ -473,7 +473,10 @@ impl Forecaster {
         let slow_rad_s = std::f64::consts::TAU / (steps.max(1) as f64 * dt);
         let turning = track.turn_rate_rad_s != 0.0 && track.turn_start_s < steps as f64 * dt;
         let piece_steps = if turning {
-            ((track.piece_rad / track.turn_rate_rad_s.abs() / dt).floor() as usize).max(1)
+            ((track.piece_rad / track.turn_rate_rad_s.abs() / dt)
+                .min((steps + 1) as f64)
+                .floor() as usize)
+                .max(1)
         } else {
             steps + 1
         };
@@ -489,7 +492,7 @@ impl Forecaster {
             } else if k0 < turn_k {
                 turn_k.min(steps + 1)
             } else {
-                (k0 + piece_steps).min(steps + 1)
+                k0.saturating_add(piece_steps).min(steps + 1)
             };
             let t_s = k0 as f64 * dt;
             let (psi, p) = track.pose(t_s);
@@ -519,15 +522,16 @@ impl Forecaster {
                 }
                 if piece_turns {
                     let end = &mut self.x_ends[c * nm..(c + 1) * nm];
-                    // an end outside the database's headings keeps the start's value
-                    if model
+                    // an end outside the database's headings keeps the start's value over this piece,
+                    // and the next piece looks its start up again (and is left out there)
+                    let known = model
                         .db
                         .excitation_into(w.omega_rad_s, w.heading_rad - psi_e, end)
-                        .is_err()
-                    {
+                        .is_ok();
+                    if !known {
                         end.copy_from_slice(&self.xbuf);
                     }
-                    self.x_ends_known[c] = true;
+                    self.x_ends_known[c] = known;
                 }
                 let k = self.k_rad_m[c];
                 let we = if piece_turns {

@@ -134,6 +134,9 @@ pub struct Done {
 /// The speed steps the compute thread rebuilds a speed-dependent model at, m/s: the forward speed from
 /// navigation is rounded to it (B_U U and C_UQ U^2 then within 0.125 m/s of the speed's).
 pub const MODEL_SPEED_STEP_M_S: f64 = 0.25;
+/// ... and rebuilds only when the speed is more than this many steps from the model's: a speed near
+/// the middle between two steps does not rebuild the model on every forecast.
+pub const MODEL_SPEED_HYSTERESIS: f64 = 0.6;
 
 /// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
 pub struct Computer {
@@ -182,7 +185,10 @@ impl Computer {
             return Ok(());
         };
         let want = (track.map_or(0.0, |t| t.speed_m_s) / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
-        if (want - self.model.opts.speed_m_s).abs() < 1e-9 || self.failed_speed == Some(want) {
+        // a speed between two steps keeps the model it has (no rebuild per forecast on noise)
+        let speed = track.map_or(0.0, |t| t.speed_m_s);
+        let near = (speed - self.model.opts.speed_m_s).abs() <= MODEL_SPEED_HYSTERESIS * MODEL_SPEED_STEP_M_S;
+        if near || (want - self.model.opts.speed_m_s).abs() < 1e-9 || self.failed_speed == Some(want) {
             return Ok(());
         }
         // tried once per speed step: an error is logged once, the model kept

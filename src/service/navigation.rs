@@ -8,7 +8,9 @@
 //!
 //! The pose at t0 is a least-squares straight line through the window's fixes, per value (heading,
 //! east, north), evaluated at t0: the wave-frequency yaw and sway in the fixes average out and a steady
-//! turn is followed without lag. The forward speed is the mean speed through the water where the
+//! turn is followed without lag (the rate of turn is the heading's slope; a wire rate of turn is
+//! checked but not used: it carries the wave-frequency yaw rate). Fixes spanning less than
+//! [`MIN_TREND_SHARE`] of the window give no rate of turn, and positions moved by the mean velocity. The forward speed is the mean speed through the water where the
 //! sensor gives it, else the mean speed over ground projected on the heading (no current known).
 
 use crate::ipc::wire::{NavigationSample, nav_valid};
@@ -20,6 +22,9 @@ use std::f64::consts::TAU;
 pub const MAX_SPEED_M_S: f64 = 25.0;
 /// The fastest rate of turn a fix may report, deg/s (a ship's, with room).
 pub const MAX_TURN_DEG_S: f64 = 30.0;
+/// The fixes must span this share of the window for their trend (rate of turn, the position's line)
+/// to be used.
+pub const MIN_TREND_SHARE: f64 = 0.5;
 /// Fixes kept beyond the fitting window, s.
 const KEEP_MARGIN_S: f64 = 5.0;
 
@@ -148,23 +153,27 @@ impl NavTrack {
         let n = used.len() as f64;
         let tm = used.iter().map(|f| f.time_s).sum::<f64>() / n;
         let stt: f64 = used.iter().map(|f| (f.time_s - tm).powi(2)).sum();
-        // a line through the fixes, at t0 (its slope 0 when they span no time)
-        let line = |value: &dyn Fn(&Fix) -> f64| -> (f64, f64) {
-            let mean = used.iter().map(|f| value(f)).sum::<f64>() / n;
-            let slope = if stt > 1e-6 {
-                used.iter().map(|f| (f.time_s - tm) * (value(f) - mean)).sum::<f64>() / stt
-            } else {
-                0.0
-            };
-            (mean + slope * (t0_s - tm), slope)
-        };
-        let (heading, rate) = line(&|f| f.heading_rad);
-        let (east, _) = line(&|f| f.position_m[0]);
-        let (north, _) = line(&|f| f.position_m[1]);
+        // fixes spanning less than half the window give no trend: a few fixes would turn their yaw
+        // noise into a rate of turn the forecast would follow for minutes
+        let span = newest - used[0].time_s;
+        let trend = span >= MIN_TREND_SHARE * window_s && stt > 0.0;
         let velocity = [
             used.iter().map(|f| f.velocity_m_s[0]).sum::<f64>() / n,
             used.iter().map(|f| f.velocity_m_s[1]).sum::<f64>() / n,
         ];
+        // a line through the fixes, at t0 (without a trend: their mean, moved at `drift` to t0)
+        let line = |value: &dyn Fn(&Fix) -> f64, drift: f64| -> (f64, f64) {
+            let mean = used.iter().map(|f| value(f)).sum::<f64>() / n;
+            let slope = if trend {
+                used.iter().map(|f| (f.time_s - tm) * (value(f) - mean)).sum::<f64>() / stt
+            } else {
+                drift
+            };
+            (mean + slope * (t0_s - tm), slope)
+        };
+        let (heading, rate) = line(&|f| f.heading_rad, 0.0);
+        let (east, _) = line(&|f| f.position_m[0], velocity[0]);
+        let (north, _) = line(&|f| f.position_m[1], velocity[1]);
         let stw: Vec<f64> = used.iter().filter_map(|f| f.stw_m_s).collect();
         // each fix's velocity along its own heading (the mean velocity lags a turning heading)
         let speed = if stw.is_empty() {
@@ -198,7 +207,7 @@ pub fn to_wire(vessel: u32, time_s: f64, fix: &crate::sim::NavFix) -> Navigation
         heading_deg: compass(fix.heading_rad),
         sog_m_s: fix.speed_m_s,
         cog_deg: compass(fix.course_rad),
-        stw_m_s: fix.speed_m_s,
+        stw_m_s: fix.stw_m_s,
         rot_deg_s: -fix.turn_rate_rad_s.to_degrees(),
         valid: nav_valid::STW | nav_valid::ROT,
         reserved: 0,
@@ -251,6 +260,20 @@ mod tests {
             p.turn_rate_rad_s
         );
         assert!((p.speed_m_s - 3.0).abs() < 1e-3);
+    }
+
+    /// Was: two fixes 1 s apart, their heading 1 deg apart from wave-frequency yaw, gave a rate of turn
+    /// of 1 deg/s that a forecast would follow for minutes.
+    #[test]
+    fn a_few_fixes_give_no_rate_of_turn() {
+        let mut tr = NavTrack::default();
+        tr.push(&sample(0.0, 90.0, 0.0, 0.0), 30.0).unwrap();
+        tr.push(&sample(1.0, 91.0, 0.0, 3.0), 30.0).unwrap();
+        let p = tr.pose_at(1.5, 30.0).unwrap();
+        assert_eq!(p.turn_rate_rad_s, 0.0);
+        // the mean heading, and the mean position moved by the velocity over ground
+        assert!((p.heading_rad - heading_from_compass_deg(90.5)).abs() < 1e-12);
+        assert!((p.position_m[0] - 3.0).abs() < 1e-3, "{:?}", p.position_m);
     }
 
     #[test]

@@ -52,12 +52,14 @@ fn disc_exit(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> f64 {
     ((-b + disc.sqrt()) / a).max(0.0)
 }
 
-/// Steps of [`coverage_exit`]'s march, m.
+/// Steps of [`coverage_exit`]'s march, m (longer on a region so large that it would take more than
+/// [`COVERAGE_STEPS`]).
 const COVERAGE_STEP_M: f64 = 10.0;
+const COVERAGE_STEPS: f64 = 400.0;
 
 /// Lead time at which the water reaching a vessel at `position` (moving relative to a group at `rel`)
 /// was outside a coverage region at t0: the first t at which `position + rel t` leaves it, marched in
-/// steps of [`COVERAGE_STEP_M`] (0 if the vessel starts outside).
+/// steps of [`COVERAGE_STEP_M`] or more (0 if the vessel starts outside).
 fn coverage_exit(region: &Region, position: [f64; 2], rel: [f64; 2]) -> f64 {
     let Region::Coverage { ranges_m, .. } = region else {
         return 0.0;
@@ -70,7 +72,8 @@ fn coverage_exit(region: &Region, position: [f64; 2], rel: [f64; 2]) -> f64 {
         return f64::INFINITY;
     }
     let reach = 2.0 * ranges_m.iter().fold(0.0f64, |m, r| m.max(*r)) + COVERAGE_STEP_M;
-    let dt = COVERAGE_STEP_M / speed;
+    // at most COVERAGE_STEPS steps whatever the region's size
+    let dt = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS) / speed;
     let mut t = 0.0;
     while t * speed <= reach {
         let next = t + dt;
