@@ -2,10 +2,14 @@
 //! every DOF active), both radiation methods, 240 wave components in a short-crested JONSWAP sea
 //! (config/scenarios/two-ship.toml's sea), after a 600 s simulated history; and one integrator step.
 //! The two-ship state-space forecast also underway: 3 m/s and turning at 0.2 deg/s from t0 (the wave
-//! force in pieces of 2 deg of heading). Setup (loading, fitting, the spin-up) is outside the timing.
+//! force in pieces of 2 deg of heading). The band of the two-ship forecast (`rom::spread`: every
+//! component's response variance and the leads it is known over, as the daemon adds it to each
+//! forecast), against the forecast it goes with. Setup (loading, fitting, the spin-up, the response
+//! table) is outside the timing.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::files::load_system;
+use shipcast::rom::spread::{ModelErrorCurve, ResponseTable, SpreadOptions, spread};
 use shipcast::rom::stepper::Stepper;
 use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel, Track};
 use shipcast::scenario::{Prepared, Scenario, past_options, prepare};
@@ -42,6 +46,31 @@ fn benches(c: &mut Criterion) {
                 b.iter(|| fc.forecast(&model, black_box(&req)).map(|f| f.steps).unwrap())
             });
             if name == "two_ship_12dof" && method == RadiationMethod::StateSpace {
+                // the band: known for the first 60 s of each component (a radar's horizon)
+                let table = ResponseTable::of(&model).expect("response table");
+                let known = vec![vec![[0.0, 60.0]; req.waves.len()]; 2];
+                let opts = SpreadOptions {
+                    model_error: ModelErrorCurve::prior(0.15, 12),
+                    trusted_nrmse: 0.6,
+                };
+                let steps = (300.0 / model.opts.dt_s).round() as usize;
+                g.bench_function(format!("{name}_band"), |b| {
+                    b.iter(|| {
+                        spread(
+                            &table,
+                            black_box(req.waves),
+                            &known,
+                            2,
+                            0.0,
+                            model.g_m_s2,
+                            model.water_depth_m,
+                            steps,
+                            model.opts.dt_s,
+                            &opts,
+                        )
+                        .to_s[0]
+                    })
+                });
                 let turning = ForecastRequest {
                     track: Some(Track {
                         turn_rate_rad_s: 0.2f64.to_radians(),

@@ -68,17 +68,55 @@ impl Channel {
 }
 
 impl Channel {
+    /// The channel's standard deviation along a forecast from each series' (`sigma[s][k]`, as
+    /// `series`): sum_i |d value / d x_i| sigma_i, the bound for series that move together (heave and
+    /// pitch of a point are not independent); display units. Empty when `sigma` is.
+    pub fn sigma_along<S: AsRef<[f64]>>(&self, ext: &External, sigma: &[S]) -> Vec<f64> {
+        let n = sigma.iter().map(|s| s.as_ref().len()).min().unwrap_or(0);
+        // the channel is linear in the displacements (small rotations): its gradient once
+        let zero = vec![0.0; sigma.len()];
+        let base = self.value(ext, &zero);
+        let gradient: Vec<f64> = (0..sigma.len())
+            .map(|i| {
+                let mut x = zero.clone();
+                x[i] = 1.0;
+                (self.value(ext, &x) - base).abs()
+            })
+            .collect();
+        (0..n)
+            .map(|k| {
+                gradient
+                    .iter()
+                    .zip(sigma)
+                    .filter(|(g, _)| **g > 0.0)
+                    .map(|(g, s)| g * s.as_ref()[k])
+                    .sum()
+            })
+            .collect()
+    }
+
     /// The trusted horizon of this channel from the vessels' horizons (a relative motion: the shorter
     /// of its two vessels'), s.
     pub fn horizon_s(&self, ext: &External, horizon_s: &[f64]) -> f64 {
-        let h = |b: usize| horizon_s.get(b).copied().unwrap_or(0.0);
+        self.of_vessels(ext, horizon_s, f64::min)
+    }
+
+    /// The start of this channel's trusted span from the vessels' starts (a relative motion: the
+    /// later of its two vessels'), s.
+    pub fn trusted_from_s(&self, ext: &External, from_s: &[f64]) -> f64 {
+        self.of_vessels(ext, from_s, f64::max)
+    }
+
+    /// A per-vessel number of the channel's vessel, or of its two vessels joined by `join`.
+    fn of_vessels(&self, ext: &External, per_vessel: &[f64], join: fn(f64, f64) -> f64) -> f64 {
+        let h = |b: usize| per_vessel.get(b).copied().unwrap_or(0.0);
         match self.source {
             Source::Dof { vessel, .. } => h(vessel),
             Source::Point { point, .. } => ext.points.get(point).map_or(0.0, |p| h(p.body)),
             Source::Relative { relative, .. } => ext
                 .relative_motions
                 .get(relative)
-                .map_or(0.0, |r| h(ext.points[r.a].body).min(h(ext.points[r.b].body))),
+                .map_or(0.0, |r| join(h(ext.points[r.a].body), h(ext.points[r.b].body))),
         }
     }
 }
@@ -193,6 +231,30 @@ pub fn inside(values: &[&[f64]], limits: &[f64]) -> Vec<bool> {
                 .iter()
                 .zip(limits)
                 .all(|(v, l)| v[k].is_finite() && v[k].abs() <= *l)
+        })
+        .collect()
+}
+
+/// Whether every channel is inside its limit with at least `confidence` probability, sample by
+/// sample, each channel normal with mean `values[c][k]` and standard deviation `sigmas[c][k]` (an
+/// empty `sigmas[c]`: none). The probability that some channel is outside is at most the sum of
+/// each one's ([`crate::rom::spread::exceedance`]; no assumption on how they move together).
+pub fn inside_with_confidence(values: &[&[f64]], sigmas: &[&[f64]], limits: &[f64], confidence: f64) -> Vec<bool> {
+    let n = values.iter().map(|v| v.len()).min().unwrap_or(0);
+    (0..n)
+        .map(|k| {
+            let mut p = 0.0;
+            for ((v, s), l) in values.iter().zip(sigmas).zip(limits) {
+                if !v[k].is_finite() {
+                    return false;
+                }
+                let sd = s.get(k).copied().unwrap_or(0.0);
+                if !sd.is_finite() {
+                    return false;
+                }
+                p += crate::rom::spread::exceedance(v[k], sd, *l);
+            }
+            p <= 1.0 - confidence
         })
         .collect()
 }
@@ -418,6 +480,26 @@ mod tests {
             ]
         );
         assert!(windows(0.0, 1.0, &[false; 4], 0.0).is_empty());
+    }
+
+    #[test]
+    fn inside_with_confidence_needs_the_band_inside_the_limit() {
+        // 0.5 with sigma 0.25 against a limit of 1: P(outside) = P(z > 2) ~ 0.023: inside at 0.9
+        let v = [0.5, 0.5, 0.5, f64::NAN];
+        let s = [0.25, 0.4, f64::NAN, 0.1];
+        let ok = inside_with_confidence(&[&v], &[&s], &[1.0], 0.9);
+        // sigma 0.4: P(z > 1.25) ~ 0.106 > 0.1: outside; a non-finite value or band: outside
+        assert_eq!(ok, vec![true, false, false, false]);
+        // two channels each at 0.06: together 0.12 > 0.1
+        let v1 = [0.0];
+        let s1 = [1.0 / 1.880_794];
+        assert_eq!(inside_with_confidence(&[&v1], &[&s1], &[1.0], 0.9), vec![true]);
+        assert_eq!(
+            inside_with_confidence(&[&v1, &v1], &[&s1, &s1], &[1.0, 1.0], 0.9),
+            vec![false]
+        );
+        // no band: the value alone
+        assert_eq!(inside_with_confidence(&[&v1], &[&[][..]], &[1.0], 0.9), vec![true]);
     }
 
     #[test]

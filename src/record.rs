@@ -19,11 +19,13 @@
 //! - `/motion` (`shipcast.Motion`): `{"vessel", "time_s", "x": [6], "v": [6]}` (measured; body-frame
 //!   surge..yaw, m and rad)
 //! - `/waves` (`shipcast.Waves`): `{"time_s", "ref_east_m", "ref_north_m", "radius_m", "depth_m",
-//!   "g_m_s2", "components": [[omega_rad_s, direction_rad, re_m, im_m], ...]}` (earth frame, as on the
+//!   "g_m_s2", "window_s", "components": [[omega_rad_s, direction_rad, re_m, im_m], ...]}` (earth frame, as on the
 //!   wire)
 //! - `/truth` (`shipcast.Motion`): like `/motion`, the simulator's true motion (absent from real logs)
 //! - `/forecast` (`shipcast.Forecast`): `{"issue_time_s", "dt_s", "steps", "flags", "wave_time_s",
-//!   "motion_time_s", "compute_ms", "horizon_s": [..], "values": [...]}` (series-major as on the wire)
+//!   "motion_time_s", "compute_ms", "horizon_s": [..], "trusted_from_s": [..], "values": [...],
+//!   "sigma": [...]}` (series-major as on the wire; `trusted_from_s` and `sigma`, the band's standard
+//!   deviations, absent from logs before version 4)
 //! - `/navigation` (`shipcast.Navigation`): `{"vessel", "time_s", "east_m", "north_m", "heading_deg",
 //!   "sog_m_s", "cog_deg", "stw_m_s", "rot_deg_s", "valid"}` (as on the wire: compass degrees,
 //!   rate of turn positive to starboard; absent from logs before version 3)
@@ -50,7 +52,7 @@ use std::path::Path;
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
 /// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
 /// `/radar`; 3: `/navigation`, `/elevation`.
-pub const LOG_SCHEMA_VERSION: u32 = 3;
+pub const LOG_SCHEMA_VERSION: u32 = 4;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -142,6 +144,9 @@ pub struct WavesRecord {
     pub depth_m: f64,
     /// Gravity, m/s2.
     pub g_m_s2: f64,
+    /// A wave probe's fitted record, s (0 or absent: not said, or not a probe).
+    #[serde(default)]
+    pub window_s: f64,
     /// Components `[omega_rad_s, direction_rad (travel-to, counterclockwise from east), re_m, im_m]`.
     pub components: Vec<[f64; 4]>,
 }
@@ -164,10 +169,16 @@ pub struct ForecastRecord {
     pub motion_time_s: f64,
     /// Compute time, ms.
     pub compute_ms: f64,
-    /// Trusted horizon per vessel, s.
+    /// End of the trusted span per vessel, s of lead.
     pub horizon_s: Vec<f64>,
+    /// Start of the trusted span per vessel, s of lead (absent before log version 4: 0).
+    #[serde(default)]
+    pub trusted_from_s: Vec<f64>,
     /// Series-major: 6 series per vessel (surge..yaw, m and rad), `steps + 1` values each.
     pub values: Vec<f64>,
+    /// The band: a standard deviation per value, same layout (absent before log version 4: empty).
+    #[serde(default)]
+    pub sigma: Vec<f64>,
 }
 
 impl MotionRecord {
@@ -192,6 +203,7 @@ impl WavesRecord {
             radius_m: h.radius_m,
             depth_m: h.depth_m,
             g_m_s2: h.g_m_s2,
+            window_s: h.window_s,
             components: f.flat_rows().collect(),
         }
     }
@@ -203,13 +215,23 @@ impl WavesRecord {
             radius_m: self.radius_m,
             depth_m: self.depth_m,
             g_m_s2: self.g_m_s2,
+            window_s: self.window_s,
         };
         WaveField::from_flat(h, self.components.iter().copied()).map_err(|e| e.to_string())
     }
 }
 
 impl ForecastRecord {
-    pub fn of(h: &ForecastHeader, values: &[f64]) -> ForecastRecord {
+    /// The record of a forecast as on the wire: `payload` holds the displacements, then the standard
+    /// deviations (a payload without them records an empty band).
+    pub fn of(h: &ForecastHeader, payload: &[f64]) -> ForecastRecord {
+        let nv = (h.n_vessels as usize).min(h.horizon_s.len());
+        let n = (h.steps as usize + 1) * 6 * nv;
+        let (values, sigma) = if payload.len() >= 2 * n {
+            (&payload[..n], &payload[n..2 * n])
+        } else {
+            (payload, &[][..])
+        };
         ForecastRecord {
             issue_time_s: h.issue_time_s,
             dt_s: h.dt_s,
@@ -218,8 +240,10 @@ impl ForecastRecord {
             wave_time_s: h.wave_time_s,
             motion_time_s: h.motion_time_s,
             compute_ms: h.compute_ms,
-            horizon_s: h.horizon_s[..h.n_vessels as usize].to_vec(),
+            horizon_s: h.horizon_s[..nv].to_vec(),
+            trusted_from_s: h.trusted_from_s[..nv].to_vec(),
             values: values.to_vec(),
+            sigma: sigma.to_vec(),
         }
     }
 }

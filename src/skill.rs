@@ -1,7 +1,9 @@
 //! Forecast skill against what happened (pure): per series (vessel DOF or point) and lead time, the
 //! correlation, the normalized RMS error (RMS error / standard deviation of the measurement), the
 //! surface similarity parameter SSP = |f - m| / (|f| + |m|) (0 perfect, 1 no skill) and the bias
-//! (mean of f - m). Leads are the forecast's own steps, binned to `lead_step_s`.
+//! (mean of f - m), and the band's coverage: the fraction of the measurement inside the forecast's
+//! published 90 % band (f +- 1.645 sigma, sigma the forecast's standard deviation). Leads are the
+//! forecast's own steps, binned to `lead_step_s`.
 //!
 //! Inputs: forecasts as (issue time t0, dt, values at t0 + k dt) and the measured series as samples
 //! (time, value) sorted by time; the measurement is interpolated linearly at each valid time and pairs
@@ -13,7 +15,12 @@ pub struct SeriesForecast<'a> {
     pub t0_s: f64,
     pub dt_s: f64,
     pub values: &'a [f64],
+    /// The band's standard deviation at each value (empty: none).
+    pub sigma: &'a [f64],
 }
+
+/// Half-width of the 90 % band in standard deviations (two-sided normal quantile).
+pub const Z_90: f64 = 1.644_853_626_951_472_2;
 
 /// Skill of one series against lead time.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,6 +32,8 @@ pub struct Skill {
     pub bias: Vec<f64>,
     /// Pairs behind each lead.
     pub count: Vec<usize>,
+    /// Fraction of the measurement inside the 90 % band at each lead (NaN: no forecast had a band).
+    pub coverage_90: Vec<f64>,
 }
 
 /// Linear interpolation in a sorted (time, value) series; None outside it.
@@ -58,6 +67,8 @@ pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
 pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s: f64, max_lead_s: f64) -> Skill {
     let nl = (max_lead_s / lead_step_s).floor() as usize + 1;
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![vec![]; nl];
+    // per lead: pairs with a band, and of them those inside it
+    let mut covered = vec![(0usize, 0usize); nl];
     for f in forecasts {
         for (l, p) in pairs.iter_mut().enumerate() {
             let lead = l as f64 * lead_step_s;
@@ -67,6 +78,10 @@ pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s:
             };
             if v.is_finite() && m.is_finite() {
                 p.push((*v, m));
+                if let Some(s) = f.sigma.get(k).filter(|s| s.is_finite()) {
+                    covered[l].0 += 1;
+                    covered[l].1 += usize::from((m - v).abs() <= Z_90 * s);
+                }
             }
         }
     }
@@ -77,6 +92,10 @@ pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s:
         ssp: vec![],
         bias: vec![],
         count: vec![],
+        coverage_90: covered
+            .iter()
+            .map(|(n, inside)| if *n > 0 { *inside as f64 / *n as f64 } else { f64::NAN })
+            .collect(),
     };
     for p in &pairs {
         let n = p.len() as f64;
@@ -126,6 +145,7 @@ mod tests {
                     t0_s: 10.0 * j as f64,
                     dt_s: 0.1,
                     values: v,
+                    sigma: &[],
                 })
                 .collect();
             score(&fs, &measured, 5.0, 30.0)
@@ -150,5 +170,29 @@ mod tests {
         let s = score_all(&drift);
         assert!(s.correlation[0] > 0.999 && s.correlation[6] < s.correlation[1]);
         assert!(s.nrmse[6] > s.nrmse[1]);
+        assert!(s.coverage_90.iter().all(|c| c.is_nan()));
+    }
+
+    #[test]
+    fn coverage_counts_the_measurement_inside_the_band() {
+        // forecasts of 0 with sigma 1 against a measurement that is +-1 (inside) or +-2 (outside)
+        let measured: Vec<(f64, f64)> = (0..1000)
+            .map(|k| (k as f64, if k % 4 == 0 { 2.0 } else { -1.0 }))
+            .collect();
+        let zeros = vec![0.0; 11];
+        let ones = vec![1.0; 11];
+        let fs: Vec<SeriesForecast> = (0..100)
+            .map(|j| SeriesForecast {
+                t0_s: 5.0 * j as f64,
+                dt_s: 1.0,
+                values: &zeros,
+                sigma: &ones,
+            })
+            .collect();
+        let s = score(&fs, &measured, 1.0, 10.0);
+        // three quarters of the samples are inside 1.645 sigma
+        for c in &s.coverage_90 {
+            assert!((c - 0.75).abs() < 0.03, "{:?}", s.coverage_90);
+        }
     }
 }

@@ -56,7 +56,7 @@ impl Drop for Tmux {
 }
 
 fn verdict(s: &str) -> bool {
-    s.contains("│GO: ") || s.contains("│NO-GO: ") || s.contains("│CAN'T TELL")
+    s.contains("│GO (") || s.contains("│NO-GO (") || s.contains("│CAN'T TELL")
 }
 
 #[test]

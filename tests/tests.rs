@@ -16,6 +16,7 @@ mod core_purity;
 mod daemon;
 mod external_models;
 mod forecast_cli;
+mod indep_barge_probe;
 mod kramers_kronig;
 mod replay;
 mod rom;

@@ -72,16 +72,23 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                     Received::Forecast(h, v) => {
                         let n = h.steps as usize + 1;
                         let nv = (h.n_vessels as usize).min(n_vessels);
-                        if h.schema_version != SCHEMA_VERSION || v.len() < 6 * nv * n {
+                        if h.schema_version != shipcast::ipc::wire::FORECAST_SCHEMA_VERSION || v.len() < 2 * 6 * nv * n
+                        {
                             continue;
                         }
                         Event::Forecast(Forecast {
                             issue_time_s: h.issue_time_s,
                             dt_s: h.dt_s,
                             horizon_s: h.horizon_s[..nv].to_vec(),
+                            trusted_from_s: h.trusted_from_s[..nv].to_vec(),
                             flags: flags::names(h.flags),
                             compute_ms: h.compute_ms,
                             x: v.chunks_exact(n).take(6 * nv).map(|s| s.to_vec()).collect(),
+                            sigma: v[6 * nv * n..]
+                                .chunks_exact(n)
+                                .take(6 * nv)
+                                .map(|s| s.to_vec())
+                                .collect(),
                             received_wall_s: now,
                         })
                     }
@@ -138,6 +145,7 @@ pub fn view(
         history_s: cfg.console.history_s,
         period_s: cfg.forecast.period_s,
         history_wanted_s: shipcast::service::history_wanted_s(cfg, sys),
+        confidence: cfg.operation.confidence,
         colours,
     };
     let mut console = Console::new(settings, vessels.clone(), ext);

@@ -437,7 +437,29 @@ pub fn forecast_json(
                     (p.name.clone(), json!({"x_m": x_m, "y_m": y_m, "z_m": z_m}))
                 })
                 .collect();
-            json!({"name": name, "horizon_s": finite(h.horizon_s[b]), "dofs": dofs, "points": points})
+            // the band: each DOF's standard deviation, after the displacements on the wire
+            let sigma0 = 6 * n_vessels * n;
+            let sigma: Map<String, Value> = Dof::ALL
+                .iter()
+                .map(|d| {
+                    let s = 6 * b + d.index();
+                    let v: Vec<Value> = values
+                        .get(sigma0 + s * n..sigma0 + (s + 1) * n)
+                        .unwrap_or(&[])
+                        .iter()
+                        .map(|x| finite(d.to_output(*x)))
+                        .collect();
+                    (d.output_name().to_string(), Value::Array(v))
+                })
+                .collect();
+            json!({
+                "name": name,
+                "trusted_from_s": finite(h.trusted_from_s[b]),
+                "horizon_s": finite(h.horizon_s[b]),
+                "dofs": dofs,
+                "sigma": sigma,
+                "points": points
+            })
         })
         .collect();
     json!({
@@ -514,7 +536,7 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
         for r in &got {
             match r {
                 Received::Forecast(h, v) => {
-                    if h.schema_version != shipcast::ipc::wire::SCHEMA_VERSION {
+                    if h.schema_version != shipcast::ipc::wire::FORECAST_SCHEMA_VERSION {
                         eprintln!("skipping a forecast of schema version {}", h.schema_version);
                         continue;
                     }

@@ -158,6 +158,10 @@ pub struct ForecastPanel {
     pub limit: f64,
     /// Lead time up to which the forecast is trusted, s.
     pub trusted_s: f64,
+    /// ... and from which, s.
+    pub trusted_from_s: f64,
+    /// The forecast's 90 % band: (lead, low, high) (empty: none).
+    pub band: Vec<(f64, f64, f64)>,
     pub forecast: Vec<(f64, f64)>,
     pub actual: Vec<(f64, f64)>,
 }
@@ -192,16 +196,24 @@ impl Figure for ForecastFigure<'_> {
                 .iter()
                 .chain(&p.actual)
                 .map(|q| q.1.abs())
+                .chain(p.band.iter().map(|b| b.1.abs().max(b.2.abs())))
                 .filter(|v| v.is_finite())
                 .fold(1.2 * p.limit.abs(), f64::max)
                 .max(1e-9)
                 * 1.1;
             let mut chart = ChartBuilder::on(&plot)
                 .caption(
-                    format!(
-                        "{}: limit ±{} {}, trusted {:.0} s",
-                        p.name, p.limit, p.unit, p.trusted_s
-                    ),
+                    if p.trusted_from_s > 0.0 {
+                        format!(
+                            "{}: limit ±{} {}, trusted {:.0}-{:.0} s",
+                            p.name, p.limit, p.unit, p.trusted_from_s, p.trusted_s
+                        )
+                    } else {
+                        format!(
+                            "{}: limit ±{} {}, trusted {:.0} s",
+                            p.name, p.limit, p.unit, p.trusted_s
+                        )
+                    },
                     style(16),
                 )
                 .margin(8)
@@ -259,8 +271,31 @@ impl Figure for ForecastFigure<'_> {
                         ),
                 ))?;
             }
+            // the band, shaded under everything else
+            if !p.band.is_empty() {
+                let outline: Vec<(f64, f64)> = p
+                    .band
+                    .iter()
+                    .map(|b| (b.0, b.2))
+                    .chain(p.band.iter().rev().map(|b| (b.0, b.1)))
+                    .filter(|q| q.1.is_finite())
+                    .collect();
+                chart.draw_series(std::iter::once(Polygon::new(outline, FORECAST.mix(0.18).filled())))?;
+            }
             let t_h = p.trusted_s.clamp(0.0, span);
+            let t_f = p.trusted_from_s.clamp(0.0, t_h);
             line(&mut chart, &[(t_h, -peak), (t_h, peak)], hz)?;
+            if t_f > 0.0 {
+                line(&mut chart, &[(t_f, -peak), (t_f, peak)], hz)?;
+                chart.draw_series(std::iter::once(
+                    EmptyElement::at((t_f, -peak))
+                        + Text::new(
+                            format!("trusted from {t_f:.0} s"),
+                            (5, -4),
+                            style(13).color(&HORIZON).pos(Pos::new(HPos::Left, VPos::Bottom)),
+                        ),
+                ))?;
+            }
             let left = t_h > 0.6 * span;
             chart.draw_series(std::iter::once(
                 EmptyElement::at((t_h, peak))
@@ -273,14 +308,23 @@ impl Figure for ForecastFigure<'_> {
                     ),
             ))?;
             line(&mut chart, &p.actual, truth)?;
-            let before: Vec<(f64, f64)> = p.forecast.iter().copied().filter(|q| q.0 <= t_h).collect();
-            // the dashed part starts at the last trusted sample, so the two join
+            // solid over the trusted span, dashed before and after it (joined at its ends)
+            let early: Vec<(f64, f64)> = p.forecast.iter().copied().filter(|q| q.0 <= t_f).collect();
+            let before: Vec<(f64, f64)> = p
+                .forecast
+                .iter()
+                .copied()
+                .filter(|q| q.0 >= t_f && q.0 <= t_h)
+                .collect();
             let after: Vec<(f64, f64)> = match before.last() {
                 Some(&b) => std::iter::once(b)
                     .chain(p.forecast.iter().copied().filter(|q| q.0 > t_h))
                     .collect(),
                 None => p.forecast.clone(),
             };
+            if t_f > 0.0 {
+                line(&mut chart, &early, fc_past)?;
+            }
             line(&mut chart, &before, fc)?;
             line(&mut chart, &after, fc_past)?;
             legend(
@@ -289,7 +333,7 @@ impl Figure for ForecastFigure<'_> {
                 &[
                     (format!("{} motion", self.reference), truth),
                     ("forecast (trusted)".into(), fc),
-                    ("forecast past the horizon".into(), fc_past),
+                    ("forecast outside the span".into(), fc_past),
                     (format!("limits ±{} {}", p.limit, p.unit), lim),
                     (format!("trusted horizon {t_h:.0} s"), hz),
                 ],
@@ -486,6 +530,11 @@ mod tests {
                 unit: "m".into(),
                 limit: 1.0,
                 trusted_s: 80.0,
+                trusted_from_s: 0.0,
+                band: wave(0.75, 0.7)
+                    .into_iter()
+                    .map(|(t, v)| (t, v - 0.2, v + 0.2))
+                    .collect(),
                 forecast: wave(0.75, 0.7),
                 actual,
             },
@@ -494,6 +543,8 @@ mod tests {
                 unit: "deg".into(),
                 limit: 2.0,
                 trusted_s: 95.0,
+                trusted_from_s: 20.0,
+                band: vec![],
                 forecast: wave(2.5, 0.5),
                 actual: wave(2.4, 0.5),
             },
@@ -507,7 +558,8 @@ mod tests {
             "carrier.roll (deg)",
             "truth motion",
             "forecast (trusted)",
-            "forecast past the horizon",
+            "forecast outside the span",
+            "trusted from 20 s",
             "limits ±1 m",
             "limit +2 deg",
             "trusted horizon 80 s",

@@ -449,8 +449,16 @@ fn forecast_plot(
                     (k as f64 * f.dt_s, v)
                 })
                 .collect();
-            let forecast = ch
-                .along(ext, &series)
+            let along = ch.along(ext, &series);
+            let sigma_series: Vec<&[f64]> = f.sigma.chunks_exact(n).collect();
+            let band = ch
+                .sigma_along(ext, &sigma_series)
+                .into_iter()
+                .zip(&along)
+                .enumerate()
+                .map(|(k, (s, v))| (k as f64 * f.dt_s, v - skill::Z_90 * s, v + skill::Z_90 * s))
+                .collect();
+            let forecast = along
                 .into_iter()
                 .enumerate()
                 .map(|(k, v)| (k as f64 * f.dt_s, v))
@@ -460,6 +468,8 @@ fn forecast_plot(
                 unit: ch.unit().into(),
                 limit: ch.limit,
                 trusted_s: ch.horizon_s(ext, &f.horizon_s).min(span),
+                trusted_from_s: ch.trusted_from_s(ext, &f.trusted_from_s),
+                band,
                 forecast,
                 actual,
             }
@@ -482,7 +492,7 @@ fn report(
     let nb = sys.spec.bodies.len();
     let step = 5.0;
     let mut json_vessels = vec![];
-    let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,count\n");
+    let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,coverage_90,count\n");
     let mut curves: Vec<plot::SkillCurve> = vec![];
     let mut lead = vec![];
     for b in 0..nb {
@@ -499,6 +509,7 @@ fn report(
                         t0_s: f.issue_time_s,
                         dt_s: f.dt_s,
                         values: f.values.get(s * n..(s + 1) * n).unwrap_or(&[]),
+                        sigma: f.sigma.get(s * n..(s + 1) * n).unwrap_or(&[]),
                     }
                 })
                 .collect();
@@ -517,17 +528,18 @@ fn report(
                     .join(",")
             };
             dofs.push(format!(
-                "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"count\":[{}]}}",
+                "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"count\":[{}]}}",
                 arr(&sk.correlation),
                 arr(&sk.nrmse),
                 arr(&sk.ssp),
                 arr(&sk.bias),
+                arr(&sk.coverage_90),
                 sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")
             ));
             for l in 0..sk.lead_s.len() {
                 csv.push_str(&format!(
-                    "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{}\n",
-                    sk.lead_s[l], sk.correlation[l], sk.nrmse[l], sk.ssp[l], sk.bias[l], sk.count[l]
+                    "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
+                    sk.lead_s[l], sk.correlation[l], sk.nrmse[l], sk.ssp[l], sk.bias[l], sk.coverage_90[l], sk.count[l]
                 ));
             }
             if ["heave", "roll", "pitch"].contains(dof) {
@@ -541,10 +553,24 @@ fn report(
         json_vessels.push(format!("\"{name}\":{{{}}}", dofs.join(",")));
     }
     let lead_json = lead.iter().map(|l| format!("{l}")).collect::<Vec<_>>().join(",");
+    // the median published trusted span of each vessel over the log
+    let median = |get: fn(&ForecastRecord) -> &Vec<f64>| -> String {
+        (0..nb)
+            .map(|b| {
+                let mut v: Vec<f64> = forecasts.iter().filter_map(|f| get(f).get(b).copied()).collect();
+                v.sort_by(f64::total_cmp);
+                let m = v.get(v.len() / 2).map_or("null".to_string(), |x| format!("{x:.3}"));
+                format!("\"{}\":{m}", sys.spec.bodies[b].name)
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let horizons = median(|f| &f.horizon_s);
+    let froms = median(|f| &f.trusted_from_s);
     std::fs::write(
         dir.join("skill.json"),
         format!(
-            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"vessels\":{{{}}}}}\n",
+            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"trusted_horizon_s\":{{{horizons}}},\"trusted_from_s\":{{{froms}}},\"vessels\":{{{}}}}}\n",
             forecasts.len(),
             json_vessels.join(",")
         ),
@@ -579,9 +605,10 @@ pub struct ImportArgs {
     /// A field every this many seconds of a probe record.
     #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
     probe_period: f64,
-    /// ... fitted to this many seconds of it.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 120.0)]
-    probe_window: f64,
+    /// ... fitted to this many seconds of it (default: what the waves take from the probe to the
+    /// farthest vessel at the band's slowest group velocity, and 30 s, at least 120 s).
+    #[arg(long, allow_negative_numbers = true)]
+    probe_window: Option<f64>,
     /// Frequencies kept from a probe record, rad/s.
     #[arg(long, default_value = "0.25:1.6")]
     band: String,
@@ -589,7 +616,7 @@ pub struct ImportArgs {
 
 /// `shipcast import`: external CSV recordings written as a log that `shipcast replay` takes.
 pub fn import(a: &ImportArgs) -> Result<()> {
-    use shipcast::replay::import::{ProbeOptions, motion_csv, probe_csv, probe_fields};
+    use shipcast::replay::import::{ProbeOptions, default_probe_window_s, motion_csv, probe_csv, probe_fields};
     let cfg = load_config(&a.config)?;
     let sys = super::daemon::load_system(&cfg)?;
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
@@ -601,7 +628,13 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         .split_once(':')
         .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
         .with_context(|| format!("--band {}: expected MIN:MAX in rad/s", a.band))?;
-    for (name, v) in [("--probe-period", a.probe_period), ("--probe-window", a.probe_window)] {
+    for (name, v) in [
+        ("--probe-period", Some(a.probe_period)),
+        ("--probe-window", a.probe_window),
+    ]
+    .into_iter()
+    .filter_map(|(n, v)| Some((n, v?)))
+    {
         if !(v.is_finite() && v > 0.0) {
             bail!("{name} {v}: must be positive");
         }
@@ -613,19 +646,38 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         eprintln!("{}: {} motion samples", p.display(), m.len());
         records.extend(m.into_iter().map(|r| (r.time_s, Record::Motion(r))));
     }
-    let opts = ProbeOptions {
-        period_s: a.probe_period,
-        window_s: a.probe_window,
-        band_rad_s: band,
-        g_m_s2: sys.spec.g_m_s2,
-        depth_m: sys.spec.water_depth_m,
-        towards_deg: a.towards_deg,
-    };
+    let (vessels_m, _) = shipcast::service::vessel_positions(&cfg, &sys);
     for p in &a.probe {
         let file = p.display().to_string();
         let rec = probe_csv(&read(p)?, &file).map_err(|e| anyhow::anyhow!(e))?;
+        let window_s = a.probe_window.unwrap_or_else(|| {
+            rec.towards_deg
+                .or(a.towards_deg)
+                .map_or(shipcast::replay::import::MIN_PROBE_WINDOW_S, |towards| {
+                    default_probe_window_s(
+                        rec.position_m,
+                        towards,
+                        &vessels_m,
+                        band,
+                        sys.spec.g_m_s2,
+                        sys.spec.water_depth_m,
+                    )
+                })
+        });
+        let opts = ProbeOptions {
+            period_s: a.probe_period,
+            window_s,
+            band_rad_s: band,
+            g_m_s2: sys.spec.g_m_s2,
+            depth_m: sys.spec.water_depth_m,
+            towards_deg: a.towards_deg,
+        };
         let f = probe_fields(&rec, &opts, &file).map_err(|e| anyhow::anyhow!(e))?;
-        eprintln!("{file}: {} samples, {} wave fields", rec.time_s.len(), f.len());
+        eprintln!(
+            "{file}: {} samples, {} wave fields, each fitted to {window_s:.0} s",
+            rec.time_s.len(),
+            f.len()
+        );
         records.extend(f.into_iter().map(|w| (w.time_s, Record::Waves(w))));
     }
     records.sort_by(|x, y| x.0.total_cmp(&y.0));

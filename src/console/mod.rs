@@ -69,6 +69,8 @@ pub struct Settings {
     /// The measured history the daemon's forecasts want behind them, s ([`crate::service::history_wanted_s`]):
     /// how long the console says the warm-up lasts.
     pub history_wanted_s: f64,
+    /// The confidence of a go (`operation.confidence`): the band drawn holds this probability.
+    pub confidence: f64,
     pub colours: Colours,
 }
 
@@ -77,11 +79,15 @@ pub struct Settings {
 pub struct Forecast {
     pub issue_time_s: f64,
     pub dt_s: f64,
-    /// Predictable horizon per vessel, s.
+    /// End of each vessel's trusted span, s of lead.
     pub horizon_s: Vec<f64>,
+    /// Start of each vessel's trusted span, s of lead.
+    pub trusted_from_s: Vec<f64>,
     pub flags: Vec<&'static str>,
     pub compute_ms: f64,
     pub x: Vec<Vec<f64>>,
+    /// The band: standard deviation of each series at each step (as `x`; empty: none sent).
+    pub sigma: Vec<Vec<f64>>,
     /// When it arrived (wall clock).
     pub received_wall_s: f64,
 }
@@ -162,8 +168,10 @@ pub struct Console {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outlook {
     pub verdict: Verdict,
-    /// The trusted span (min of the channels' horizons), s.
+    /// The trusted span's end (min of the channels' horizons), s.
     pub trusted_s: f64,
+    /// ... and its start (max of the channels' starts), s.
+    pub trusted_from_s: f64,
     /// Quiescent windows within the trusted span (times relative to the forecast's issue).
     pub windows: Vec<Window>,
     /// For a no-go: the first channel to leave its limit and when (relative s).
@@ -297,6 +305,22 @@ impl Console {
             .map_or(0.0, |f| c.horizon_s(&self.external, &f.horizon_s))
     }
 
+    /// Start of channel `c`'s trusted span for the current forecast, s (the later of its vessels').
+    pub fn trusted_from_of(&self, c: &Channel) -> f64 {
+        self.forecast
+            .as_ref()
+            .map_or(0.0, |f| c.trusted_from_s(&self.external, &f.trusted_from_s))
+    }
+
+    /// Channel `c`'s band along the current forecast: its standard deviation at each step (empty
+    /// when the forecast has none).
+    pub fn forecast_sigma(&self, c: &Channel) -> Vec<f64> {
+        self.forecast
+            .as_ref()
+            .filter(|f| !f.sigma.is_empty())
+            .map_or_else(Vec::new, |f| c.sigma_along(&self.external, &f.sigma))
+    }
+
     /// The operation's outlook from the current forecast (None without a forecast or channels).
     pub fn outlook(&self) -> Option<Outlook> {
         let f = self.forecast.as_ref()?;
@@ -305,30 +329,43 @@ impl Console {
             return None;
         }
         let series: Vec<Vec<f64>> = chans.iter().map(|c| self.forecast_channel(c)).collect();
+        let sigmas: Vec<Vec<f64>> = chans.iter().map(|c| self.forecast_sigma(c)).collect();
         let trusted_s = operation::trusted_horizon_s(chans, &self.external, &f.horizon_s);
+        let trusted_from_s = chans.iter().map(|c| self.trusted_from_of(c)).fold(0.0, f64::max);
         let n = series.iter().map(|s| s.len()).min().unwrap_or(0);
         let m = operation::trusted_samples(n, f.dt_s, trusted_s);
-        let views: Vec<&[f64]> = series.iter().map(|s| &s[..m]).collect();
+        // the trusted span's samples: from its start (a whole step) to its end
+        let first = ((trusted_from_s / f.dt_s - 1e-9).ceil().max(0.0) as usize).min(m);
+        let views: Vec<&[f64]> = series.iter().map(|s| &s[first..m]).collect();
+        let bands: Vec<&[f64]> = sigmas
+            .iter()
+            .map(|s| if s.len() >= m { &s[first..m] } else { &[][..] })
+            .collect();
         let limits: Vec<f64> = chans.iter().map(|c| c.limit).collect();
-        let ok = operation::inside(&views, &limits);
+        let ok = operation::inside_with_confidence(&views, &bands, &limits, self.settings.confidence);
         let d = self.settings.duration_s;
-        let windows = operation::windows(0.0, f.dt_s, &ok, d);
-        let verdict = if m == 0 {
+        let windows = operation::windows(first as f64 * f.dt_s, f.dt_s, &ok, d);
+        // a span that starts later cannot say whether to start now
+        let verdict = if m <= first || first > 0 {
             Verdict::Unknown
         } else {
             operation::verdict(&windows, 0.0, d)
         };
+        // the first step at which a channel is likelier than the confidence allows to be outside
         let first_exceedance = chans
             .iter()
-            .zip(&views)
-            .filter_map(|(c, s)| {
-                let k = s.iter().position(|v| !(v.is_finite() && v.abs() <= c.limit))?;
-                Some((c.name.clone(), k as f64 * f.dt_s))
+            .zip(views.iter().zip(&bands))
+            .filter_map(|(c, (s, b))| {
+                let k = operation::inside_with_confidence(&[s], &[b], &[c.limit], self.settings.confidence)
+                    .iter()
+                    .position(|ok| !ok)?;
+                Some((c.name.clone(), (first + k) as f64 * f.dt_s))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1));
         Some(Outlook {
             verdict,
             trusted_s: trusted_s.min((n.max(1) - 1) as f64 * f.dt_s),
+            trusted_from_s: first as f64 * f.dt_s,
             windows,
             first_exceedance,
         })
@@ -438,6 +475,7 @@ mod tests {
             history_s: 60.0,
             period_s: 1.0,
             history_wanted_s: 600.0,
+            confidence: 0.9,
             colours: Colours::default(),
         };
         Console::new(s, vec!["a".into(), "b".into()], External::default())
@@ -459,9 +497,11 @@ mod tests {
             issue_time_s: 1000.0,
             dt_s: 1.0,
             horizon_s: vec![horizon_s, horizon_s],
+            trusted_from_s: vec![0.0, 0.0],
             flags: vec![],
             compute_ms: 12.0,
             x,
+            sigma: vec![],
             received_wall_s: 5000.0,
         }
     }

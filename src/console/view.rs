@@ -103,7 +103,17 @@ pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
     match o.verdict {
         Verdict::Go { window_s } => (
             Severity::Ok,
-            format!("GO: every channel inside its limits for the next {window_s:.0} s ({d:.0} s operation)"),
+            format!(
+                "GO ({:.0} % confidence): every channel inside its limits for the next {window_s:.0} s ({d:.0} s operation)",
+                100.0 * c.settings.confidence
+            ),
+        ),
+        Verdict::Unknown if o.trusted_from_s > 0.0 => (
+            Severity::Caution,
+            format!(
+                "CAN'T TELL: the forecast is trusted from {:.0} s to {:.0} s ahead: not the next {:.0} s",
+                o.trusted_from_s, o.trusted_s, o.trusted_from_s
+            ),
         ),
         Verdict::Unknown => (
             Severity::Caution,
@@ -122,7 +132,13 @@ pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
                 Some(t) => format!("next window in {}", fmt_in(t)),
                 None => format!("no {d:.0} s window within the trusted {:.0} s", o.trusted_s),
             };
-            (Severity::Alarm, format!("NO-GO: {who}; {next}"))
+            (
+                Severity::Alarm,
+                format!(
+                    "NO-GO ({:.0} % confidence): {who}; {next}",
+                    100.0 * c.settings.confidence
+                ),
+            )
         }
     }
 }
@@ -151,8 +167,11 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
             s,
             format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
         ));
-        for (n, h) in c.vessels.iter().zip(&f.horizon_s) {
-            out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s")));
+        for (b, (n, h)) in c.vessels.iter().zip(&f.horizon_s).enumerate() {
+            match f.trusted_from_s.get(b).copied().filter(|x| *x > 0.0) {
+                Some(from) => out.push((Severity::Caution, format!("Trusted ahead: {n} {from:.0}-{h:.0} s"))),
+                None => out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s"))),
+            }
         }
     }
     if let Some(h) = &c.health {
@@ -300,14 +319,34 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
             .map(|k| (k as f64 * dt, fc[k]))
             .collect()
     };
-    let trusted = pts(0..k_h);
+    let from = c.trusted_from_of(ch).min(horizon);
+    let k_f = ((from / dt - 1e-9).ceil().max(0.0) as usize).min(k_h);
+    let trusted = pts(k_f..k_h);
+    let before = pts(0..(k_f + 1).min(fc.len()));
     let beyond = pts(k_h.saturating_sub(1)..fc.len());
+    // the band holding the go's confidence: forecast +- z sigma
+    let sigma = c.forecast_sigma(ch);
+    let z = crate::rom::spread::band_z(c.settings.confidence);
+    let band = |sign: f64| -> Vec<(f64, f64)> {
+        (0..fc.len().min(sigma.len()))
+            .filter(|k| fc[*k].is_finite() && sigma[*k].is_finite())
+            .map(|k| (k as f64 * dt, fc[k] + sign * z * sigma[k]))
+            .collect()
+    };
+    let (band_hi, band_lo) = (band(1.0), band(-1.0));
     let measured = c.measured_channel(ch, t0, -hist);
     let x_max = span_s.max(10.0);
+    // the band within the trusted span sets the scale too (beyond it, it may grow without bound)
+    let band_trusted = band_hi
+        .iter()
+        .chain(&band_lo)
+        .filter(|p| p.0 >= from - 1e-9 && p.0 <= horizon + 1e-9);
     let peak = trusted
         .iter()
         .chain(&beyond)
+        .chain(&before)
         .chain(&measured)
+        .chain(band_trusted)
         .map(|p| p.1.abs())
         .filter(|v| v.is_finite())
         .fold(ch.limit * 1.2, f64::max);
@@ -315,6 +354,7 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     let limit_hi = [(-hist, ch.limit), (x_max, ch.limit)];
     let limit_lo = [(-hist, -ch.limit), (x_max, -ch.limit)];
     let horizon_mark = [(horizon, -y), (horizon, y)];
+    let from_mark = [(from, -y), (from, y)];
     let now_mark = [(0.0, -y), (0.0, y)];
     let fc_colour = if current {
         colours.forecast
@@ -328,6 +368,12 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     ];
     if c.forecast.is_some() {
         sets.push(set(&horizon_mark, colours.beyond_horizon));
+        if k_f > 0 {
+            sets.push(set(&from_mark, colours.beyond_horizon));
+            sets.push(set(&before, colours.beyond_horizon));
+        }
+        sets.push(set(&band_hi, colours.beyond_horizon));
+        sets.push(set(&band_lo, colours.beyond_horizon));
         sets.push(set(&beyond, colours.beyond_horizon));
         sets.push(set(&trusted, fc_colour));
     }
@@ -335,6 +381,8 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     let marker = if selected { "▶ " } else { "" };
     let status = if c.forecast.is_none() {
         String::new()
+    } else if current && k_f > 0 {
+        format!(" · trusted {from:.0}-{horizon:.0} s")
     } else if current {
         format!(" · trusted {horizon:.0} s")
     } else {
@@ -460,7 +508,8 @@ fn draw_help(frame: &mut Frame, area: Rect) {
         Line::from("? or h       this help; Esc closes it"),
         Line::from("q            quit (the daemon keeps running)"),
         Line::from(""),
-        Line::from("Grey trace: beyond the trusted horizon. Red lines:"),
+        Line::from("Grey trace: outside the trusted span; grey lines"),
+        Line::from("around it: the band a go is judged by. Red lines:"),
         Line::from("limits. Changes here last until the console quits;"),
         Line::from("set defaults in [operation] of the config file."),
     ];
@@ -499,7 +548,7 @@ mod tests {
         assert!(
             banner(&c, 5000.5)
                 .1
-                .starts_with("GO: every channel inside its limits for the next 100 s")
+                .starts_with("GO (90 % confidence): every channel inside its limits for the next 100 s")
         );
         assert!(banner(&c, 5002.0).1.contains("NOT RESPONDING for 2 s"));
         c.on_forecast(forecast(120, 100.0, |t| if t > 10.0 { 2.0 } else { 0.0 }, |_| 0.5));
@@ -507,7 +556,7 @@ mod tests {
         assert_eq!(s, Severity::Alarm);
         assert_eq!(
             t,
-            "NO-GO: a.heave leaves its limit in 11 s; no 30 s window within the trusted 100 s"
+            "NO-GO (90 % confidence): a.heave leaves its limit in 11 s; no 30 s window within the trusted 100 s"
         );
     }
 
@@ -527,7 +576,7 @@ mod tests {
         }
         let s = screen(&c, 120, 30, 5000.5);
         assert!(
-            s.contains("GO: every channel inside its limits for the next 50 s"),
+            s.contains("GO (90 % confidence): every channel inside its limits for the next 50 s"),
             "{s}"
         );
         assert!(s.contains("▶ a.heave (m) limit ±1  · trusted 80 s"), "{s}");
@@ -544,18 +593,53 @@ mod tests {
         assert!(s.contains("NOT RESPONDING") && s.matches("STALE").count() >= 3, "{s}");
     }
 
+    /// A band: a go needs the band inside the limits with the confidence, not only the forecast.
+    #[test]
+    fn the_band_decides_a_go_and_a_later_span_cannot_tell_about_now() {
+        let mut c = two_vessels();
+        let mut f = forecast(120, 100.0, |_| 0.5, |_| 0.5);
+        // heave 0.5 m with a band widening 0.02 m per s: past 0.5 / 1.28 = 0.39 m (20 s) it is
+        // likelier than 10 % to leave the 1 m limit (the 0.5 m to the far one adds nothing), and
+        // 20 s is shorter than the 30 s operation
+        f.sigma = vec![vec![0.0; 121]; 12];
+        f.sigma[2] = (0..=120).map(|k| 0.02 * k as f64).collect();
+        c.on_forecast(f.clone());
+        let o = c.outlook().unwrap();
+        assert!(matches!(o.verdict, Verdict::NoGo { .. }), "{o:?}");
+        let (who, at) = o.first_exceedance.clone().unwrap();
+        assert_eq!(who, "a.heave");
+        assert_eq!(at, 20.0);
+        // the same forecast trusted only from 40 s: no verdict about now
+        f.sigma[2] = vec![0.05; 121];
+        f.trusted_from_s = vec![40.0, 0.0];
+        c.on_forecast(f);
+        let (sev, text) = banner(&c, 5000.5);
+        assert_eq!(sev, Severity::Caution);
+        assert_eq!(
+            text,
+            "CAN'T TELL: the forecast is trusted from 40 s to 100 s ahead: not the next 40 s"
+        );
+        let s = screen(&c, 120, 30, 5000.5);
+        assert!(s.contains("a.heave (m) limit ±1  · trusted 40-100 s"), "{s}");
+        assert!(s.contains("Trusted ahead: a 40-100 s"), "{s}");
+    }
+
     /// The whole screen, compared with `src/console/snapshots/` (review a change with `cargo insta
-    /// review`, or accept it with `INSTA_UPDATE=always cargo test --lib console`).
+    /// review`, or accept it with `INSTA_UPDATE=always cargo test --lib console`): the band around
+    /// each forecast, the span, the confidence of the verdict.
     #[test]
     fn snapshot_of_a_no_go_screen() {
         let mut c = two_vessels();
         c.selected = 1;
-        c.on_forecast(forecast(
+        let mut f = forecast(
             120,
             60.0,
             |t| 0.8 * (t / 8.0).sin(),
             |t| if t < 15.0 { 2.5 } else { 1.0 },
-        ));
+        );
+        f.sigma = vec![(0..=120).map(|k| 0.05 + 0.004 * k as f64).collect(); 12];
+        f.sigma[9] = (0..=120).map(|k| (0.1 + 0.005 * k as f64).to_radians()).collect();
+        c.on_forecast(f);
         for k in 0..=60 {
             let t = 940.0 + k as f64;
             c.on_motion(0, t, &[0.0, 0.0, 0.6 * (t / 8.0).sin(), 0.0, 0.0, 0.0]);
@@ -569,7 +653,7 @@ mod tests {
         let mut c = two_vessels();
         c.on_forecast(forecast(120, 100.0, |_| 0.2, |_| 0.5));
         let s = screen(&c, 50, 10, 5000.5);
-        assert!(s.contains("GO: every"), "{s}");
+        assert!(s.contains("GO (90 % confidence): every"), "{s}");
         assert!(s.contains("a.heave: now 0.20, max 0.20"), "{s}");
         assert!(!s.contains('┌'), "{s}");
     }

@@ -1,4 +1,5 @@
-//! The iceoryx2 wire types: what goes over shared memory, field by field (schema version 1).
+//! The iceoryx2 wire types: what goes over shared memory, field by field (schema version 1; the
+//! forecast's 2, the status's 3).
 //!
 //! Every payload is `#[repr(C)]` with a stable type name, so a C, C++ or Python subscriber can declare
 //! the same layout (`tools/console/subscriber.py` does it with ctypes). Units SI; times are seconds on
@@ -17,14 +18,19 @@
 //! - `waves`: a slice of f64 with a [`WaveHeader`]: 4 values per component: omega (rad/s), direction
 //!   (rad, earth), Re and Im of the complex amplitude (m) at the header's reference point and time.
 //! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
-//!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad).
+//!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad); then as many
+//!   standard deviations, same order (the forecast's band: `rom::spread`). Schema version
+//!   [`FORECAST_SCHEMA_VERSION`].
 //! - `status`: [`Status`].
 
 use crate::waves::field::FlatHeader;
 use iceoryx2::prelude::*;
 
-/// Schema version of the motion, waves and forecast payloads.
+/// Schema version of the motion, navigation, elevation and waves payloads.
 pub const SCHEMA_VERSION: u32 = 1;
+/// Schema version of the forecast payload (2: the standard deviations after the displacements, the
+/// start of each vessel's trusted span).
+pub const FORECAST_SCHEMA_VERSION: u32 = 2;
 /// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
 /// estimator's refusals, restarts and bias).
 pub const STATUS_SCHEMA_VERSION: u32 = 3;
@@ -216,7 +222,8 @@ pub struct WaveHeader {
     /// Water depth, m (0: infinite).
     pub depth_m: f64,
     pub g_m_s2: f64,
-    pub reserved: f64,
+    /// A wave probe's fitted record, s (0: not said, or not a probe).
+    pub window_s: f64,
 }
 
 impl WaveHeader {
@@ -231,7 +238,7 @@ impl WaveHeader {
             radius_m: h.radius_m,
             depth_m: h.depth_m,
             g_m_s2: h.g_m_s2,
-            reserved: 0.0,
+            window_s: h.window_s,
         }
     }
 
@@ -243,13 +250,14 @@ impl WaveHeader {
             radius_m: self.radius_m,
             depth_m: self.depth_m,
             g_m_s2: self.g_m_s2,
+            window_s: self.window_s,
         }
     }
 }
 
-/// Header of a forecast sample. 96 bytes.
+/// Header of a forecast sample. 128 bytes; `schema_version` = [`FORECAST_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("shipcast_ForecastHeader_v1")]
+#[type_name("shipcast_ForecastHeader_v2")]
 #[repr(C)]
 pub struct ForecastHeader {
     pub schema_version: u32,
@@ -270,8 +278,12 @@ pub struct ForecastHeader {
     pub motion_time_s: f64,
     /// Wall-clock compute time of this forecast, ms.
     pub compute_ms: f64,
-    /// Predictable horizon of each vessel, s (beyond it the forecast is not to be trusted).
+    /// End of each vessel's trusted span, s of lead (beyond it the forecast is not to be trusted; 0:
+    /// not trusted at all).
     pub horizon_s: [f64; MAX_VESSELS],
+    /// Start of each vessel's trusted span, s of lead (before it the waves that move the vessel have
+    /// not been observed yet: a probe far up-wave).
+    pub trusted_from_s: [f64; MAX_VESSELS],
 }
 
 /// Health of the daemon, published every cycle. 360 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
@@ -329,12 +341,13 @@ pub struct Status {
 
 /// Checks a received forecast against its own header, as every consumer must before indexing it
 /// (`ForecastSubscriber` does, for `watch`, `demo` and the console): the schema, the vessel count, the
-/// series count and the payload's length, a positive step, finite times and horizons.
+/// series count and the payload's length (displacements and standard deviations), a positive step,
+/// finite times and spans.
 pub fn check_forecast(h: &ForecastHeader, payload_len: usize) -> Result<(), String> {
     let n_vessels = h.n_vessels as usize;
-    if h.schema_version != SCHEMA_VERSION {
+    if h.schema_version != FORECAST_SCHEMA_VERSION {
         return Err(format!(
-            "forecast of schema version {} (this shipcast reads {SCHEMA_VERSION})",
+            "forecast of schema version {} (this shipcast reads {FORECAST_SCHEMA_VERSION})",
             h.schema_version
         ));
     }
@@ -347,10 +360,12 @@ pub fn check_forecast(h: &ForecastHeader, payload_len: usize) -> Result<(), Stri
             h.n_series
         ));
     }
-    let values = (h.steps as usize + 1).checked_mul(h.n_series as usize);
+    let values = (h.steps as usize + 1)
+        .checked_mul(h.n_series as usize)
+        .and_then(|v| v.checked_mul(2));
     if values != Some(payload_len) {
         return Err(format!(
-            "forecast of {} steps x {} series in {payload_len} values",
+            "forecast of {} steps x {} series (and their standard deviations) in {payload_len} values",
             h.steps, h.n_series
         ));
     }
@@ -362,6 +377,15 @@ pub fn check_forecast(h: &ForecastHeader, payload_len: usize) -> Result<(), Stri
     }
     if h.horizon_s[..n_vessels].iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
         return Err(format!("forecast with horizons {:?}", &h.horizon_s[..n_vessels]));
+    }
+    if h.trusted_from_s[..n_vessels]
+        .iter()
+        .any(|x| !(x.is_finite() && *x >= 0.0))
+    {
+        return Err(format!(
+            "forecast with trusted spans from {:?}",
+            &h.trusted_from_s[..n_vessels]
+        ));
     }
     Ok(())
 }
@@ -383,7 +407,7 @@ mod tests {
 
     fn good() -> ForecastHeader {
         ForecastHeader {
-            schema_version: SCHEMA_VERSION,
+            schema_version: FORECAST_SCHEMA_VERSION,
             n_vessels: 2,
             dt_s: 0.1,
             steps: 10,
@@ -396,7 +420,7 @@ mod tests {
     /// or `steps` larger than the payload, panicked).
     #[test]
     fn a_forecast_whose_header_does_not_fit_its_payload_is_refused() {
-        assert_eq!(check_forecast(&good(), 11 * 12), Ok(()));
+        assert_eq!(check_forecast(&good(), 22 * 12), Ok(()));
         let bad = [
             (
                 ForecastHeader {
@@ -404,7 +428,7 @@ mod tests {
                     n_series: 30,
                     ..good()
                 },
-                11 * 30,
+                22 * 30,
             ),
             (
                 ForecastHeader {
@@ -414,30 +438,39 @@ mod tests {
                 },
                 0,
             ),
-            (ForecastHeader { steps: 1000, ..good() }, 11 * 12),
+            (ForecastHeader { steps: 1000, ..good() }, 22 * 12),
             (
                 ForecastHeader {
                     steps: u32::MAX,
                     ..good()
                 },
-                11 * 12,
+                22 * 12,
             ),
-            (ForecastHeader { n_series: 6, ..good() }, 11 * 6),
-            (ForecastHeader { dt_s: 0.0, ..good() }, 11 * 12),
+            (ForecastHeader { n_series: 6, ..good() }, 22 * 6),
+            (ForecastHeader { dt_s: 0.0, ..good() }, 22 * 12),
             (
                 ForecastHeader {
                     schema_version: 9,
                     ..good()
                 },
-                11 * 12,
+                22 * 12,
             ),
             (
                 ForecastHeader {
                     horizon_s: [f64::INFINITY, 0.0, 0.0, 0.0],
                     ..good()
                 },
-                11 * 12,
+                22 * 12,
             ),
+            (
+                ForecastHeader {
+                    trusted_from_s: [0.0, f64::NAN, 0.0, 0.0],
+                    ..good()
+                },
+                22 * 12,
+            ),
+            // the displacements without their standard deviations (a schema 1 payload)
+            (good(), 11 * 12),
         ];
         for (h, len) in bad {
             assert!(check_forecast(&h, len).is_err(), "{h:?}");
@@ -450,7 +483,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
         assert_eq!(std::mem::size_of::<ElevationHeader>(), 64);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
-        assert_eq!(std::mem::size_of::<ForecastHeader>(), 96);
+        assert_eq!(std::mem::size_of::<ForecastHeader>(), 128);
         assert_eq!(std::mem::size_of::<Status>(), 360);
     }
 }

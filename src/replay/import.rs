@@ -243,6 +243,37 @@ pub fn probe_csv(text: &str, file: &str) -> Result<ProbeRecord, String> {
     })
 }
 
+/// The shortest default window of a probe's fit, s.
+pub const MIN_PROBE_WINDOW_S: f64 = 120.0;
+/// The default window's margin beyond the slowest group's travel, s: a few peak periods, so that the
+/// fit resolves that group's frequency from what passed the probe around it.
+pub const PROBE_WINDOW_MARGIN_S: f64 = 30.0;
+
+/// The default window of a probe's fit: the waves that reach the farthest vessel over the next
+/// seconds passed the probe as long ago as the along-wave distance over their group velocity, the
+/// slowest (the band's highest frequency) longest: that travel and [`PROBE_WINDOW_MARGIN_S`], at least
+/// [`MIN_PROBE_WINDOW_S`] (and that for a probe down-wave of every vessel, where it tells nothing).
+pub fn default_probe_window_s(
+    probe_m: [f64; 2],
+    towards_deg: f64,
+    vessels_m: &[[f64; 2]],
+    band_rad_s: (f64, f64),
+    g_m_s2: f64,
+    depth_m: Option<f64>,
+) -> f64 {
+    let d = heading_from_compass_deg(towards_deg);
+    let (s, c) = d.sin_cos();
+    let along = vessels_m
+        .iter()
+        .map(|v| c * (v[0] - probe_m[0]) + s * (v[1] - probe_m[1]))
+        .fold(0.0f64, f64::max);
+    let cg = crate::waves::field::group_velocity(band_rad_s.1, g_m_s2, depth_m);
+    if !(along > 0.0 && cg > 0.0) {
+        return MIN_PROBE_WINDOW_S;
+    }
+    (along / cg + PROBE_WINDOW_MARGIN_S).max(MIN_PROBE_WINDOW_S)
+}
+
 /// The fields a probe record gives: one every `period_s`, fitted to the last `window_s` of samples.
 pub fn probe_fields(p: &ProbeRecord, o: &ProbeOptions, file: &str) -> Result<Vec<WavesRecord>, String> {
     let towards = p
@@ -337,5 +368,31 @@ mod tests {
         assert!((eta - a * (w * 240.0).cos()).abs() < 0.02 * a, "{eta}");
         let e = probe_csv("time_s,elevation_m\n0,0\n1,0\n3,0\n4,0\n5,0\n6,0\n7,0\n8,0\n", "p.csv").unwrap_err();
         assert!(e.contains("samples must be evenly spaced"), "{e}");
+    }
+
+    /// Was: the window was 120 s whatever the probe's distance, so a probe 600 m up-wave fitted none
+    /// of the short waves that reach the vessel in the next minute (they passed it 190 s ago).
+    #[test]
+    fn the_default_window_follows_the_probe_distance() {
+        let band = (0.25, 1.6);
+        let cg = crate::waves::field::group_velocity(1.6, 9.81, None);
+        // waves to the west (270), the probe 600 m east of the vessel: up-wave
+        let w = default_probe_window_s([600.0, 0.0], 270.0, &[[0.0, 0.0]], band, 9.81, None);
+        assert!(
+            (w - (600.0 / cg + PROBE_WINDOW_MARGIN_S)).abs() < 1e-9 && w > 190.0,
+            "{w}"
+        );
+        // the farthest of two vessels decides
+        let w2 = default_probe_window_s([600.0, 0.0], 270.0, &[[0.0, 0.0], [-100.0, 50.0]], band, 9.81, None);
+        assert!((w2 - (700.0 / cg + PROBE_WINDOW_MARGIN_S)).abs() < 1e-9, "{w2}");
+        // close by, or down-wave: the shortest window
+        assert_eq!(
+            default_probe_window_s([50.0, 0.0], 270.0, &[[0.0, 0.0]], band, 9.81, None),
+            MIN_PROBE_WINDOW_S
+        );
+        assert_eq!(
+            default_probe_window_s([600.0, 0.0], 90.0, &[[0.0, 0.0]], band, 9.81, None),
+            MIN_PROBE_WINDOW_S
+        );
     }
 }

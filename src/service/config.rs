@@ -128,6 +128,13 @@ pub struct ForecastConfig {
     pub navigation_window_s: f64,
     /// Radar scans (`<prefix>/elevation`) of one grid inverted together into a field.
     pub radar_snapshots: u32,
+    /// The model's error, as a fraction of each motion's standard deviation, until the daemon has
+    /// learnt it from its own forecasts (`rom::spread::ModelError`): the floor of the forecast's band,
+    /// growing in proportion to the lead beyond 30 s.
+    pub model_error: f64,
+    /// A lead is trusted while the forecast's expected normalized RMS error (its band's standard
+    /// deviation over the motion's) is at most this, for heave, roll and pitch of the vessel.
+    pub trusted_nrmse: f64,
 }
 
 impl Default for ForecastConfig {
@@ -153,6 +160,8 @@ impl Default for ForecastConfig {
             max_navigation_age_s: 5.0,
             navigation_window_s: 30.0,
             radar_snapshots: 3,
+            model_error: 0.15,
+            trusted_nrmse: 0.6,
         }
     }
 }
@@ -415,6 +424,9 @@ pub struct OperationConfig {
     pub duration_s: f64,
     /// Channels and limits; empty: heave (1 m) and roll (2 deg) of every vessel.
     pub channels: Vec<ChannelConfig>,
+    /// The confidence of a go: a step is inside its limits when, by the forecast's band, the
+    /// probability that every channel is inside is at least this (0..1).
+    pub confidence: f64,
 }
 
 impl Default for OperationConfig {
@@ -422,6 +434,7 @@ impl Default for OperationConfig {
         OperationConfig {
             duration_s: 60.0,
             channels: vec![],
+            confidence: 0.9,
         }
     }
 }
@@ -729,6 +742,10 @@ pub const BOUNDS: &[Bound] = &[
     closed("forecast.navigation_window_s", 1.0, 600.0, "s"),
     // two tell opposite directions apart; more than a minute of 2 s scans adds nothing
     closed("forecast.radar_snapshots", 2.0, 32.0, ""),
+    // a model off by its own motion is no model
+    closed("forecast.model_error", 0.0, 1.0, ""),
+    // an expected error as large as the motion itself is no forecast
+    positive("forecast.trusted_nrmse", 1.0, ""),
     // a sensor's noise: beyond these it measures nothing of a ship's motion
     positive("estimator.noise_m", 10.0, "m"),
     positive("estimator.noise_rad", 1.0, "rad"),
@@ -788,6 +805,8 @@ pub const BOUNDS: &[Bound] = &[
     closed("simulate.navigation.heading_noise_deg", 0.0, 10.0, "deg"),
     closed("simulate.navigation.position_noise_m", 0.0, 100.0, "m"),
     positive("operation.duration_s", DAY_S, "s"),
+    // a probability: 0.5 is a coin, 0.999 asks the band for more than its calibration gives
+    closed("operation.confidence", 0.5, 0.999, ""),
     // m, or deg for rotations: beyond this every motion is inside
     positive("operation.channels.limit", 1.0e4, "m or deg"),
     positive("console.history_s", 3600.0, "s"),
@@ -828,6 +847,8 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("forecast.max_navigation_age_s", f.max_navigation_age_s),
         one("forecast.navigation_window_s", f.navigation_window_s),
         one("forecast.radar_snapshots", f.radar_snapshots as f64),
+        one("forecast.model_error", f.model_error),
+        one("forecast.trusted_nrmse", f.trusted_nrmse),
         one("estimator.noise_m", c.estimator.noise_m),
         one("estimator.noise_rad", c.estimator.noise_rad),
         one("estimator.velocity_noise_m_s", c.estimator.velocity_noise_m_s),
@@ -879,6 +900,7 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.navigation.heading_noise_deg", s.navigation.heading_noise_deg),
         one("simulate.navigation.position_noise_m", s.navigation.position_noise_m),
         one("operation.duration_s", c.operation.duration_s),
+        one("operation.confidence", c.operation.confidence),
         one("console.history_s", c.console.history_s),
     ];
     for (i, ch) in c.operation.channels.iter().enumerate() {

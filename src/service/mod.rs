@@ -20,6 +20,7 @@ pub mod navigation;
 use crate::hydro::VesselSystem;
 use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
 use crate::ipc::{self, Input, Names, Output};
+use crate::rom::spread::{self, ResponseTable, SpreadOptions};
 use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel, Track};
 use crate::waves::field::{WaveField, heading_from_compass_deg};
 use crate::waves::horizon;
@@ -115,6 +116,14 @@ pub struct Job {
     /// How many of `velocities` (the newest) were measured, fewest over the vessels.
     known: usize,
     waves: Vec<crate::waves::WaveComponent>,
+    /// Per vessel, per component of `waves`, the leads (s from t0) over which it is known
+    /// (`horizon::known_leads`).
+    known_leads: Vec<Vec<[f64; 2]>>,
+    /// Per vessel, whether the field can be trusted at all (located, navigation fresh).
+    trustworthy: Vec<bool>,
+    /// The model error of each series against lead, as a fraction of its motion
+    /// ([`spread::ModelError`]).
+    model_error: spread::ModelErrorCurve,
     /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
     track: Option<Track>,
     header: ForecastHeader,
@@ -129,6 +138,9 @@ pub struct Done {
     pub error: Option<String>,
     /// Share of the wave variance the forecast left out (outside the database), 0..1.
     pub dropped_wave_share: f64,
+    /// Each series' motion standard deviation by the band's model, and the model error the band took.
+    pub motion_sigma: Vec<f64>,
+    pub model_error: spread::ModelErrorCurve,
 }
 
 /// The speed steps the compute thread rebuilds a speed-dependent model at, m/s: the forward speed from
@@ -141,6 +153,9 @@ pub const MODEL_SPEED_HYSTERESIS: f64 = 0.6;
 /// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
 pub struct Computer {
     model: TimeModel,
+    /// The model's response for the band (None: it could not be made; nothing is trusted then).
+    table: Option<ResponseTable>,
+    trusted_nrmse: f64,
     /// The system and options to rebuild the model at another speed, when the system file has speed
     /// terms (`speed_damping` B_U, `speed_restoring` C_UQ) or databases at several speeds (interpolated:
     /// `VesselSystem::at_speed`); None: one model serves every speed (the speed then enters through the
@@ -169,6 +184,8 @@ impl Computer {
         Computer {
             rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
             failed_speed: None,
+            table: response_table(&model),
+            trusted_nrmse: cfg.forecast.trusted_nrmse,
             model,
             fc: Forecaster::new(),
             n_bodies,
@@ -208,6 +225,7 @@ impl Computer {
             speed_m_s = want,
             "model rebuilt for the forward speed (its speed terms)"
         );
+        self.table = response_table(&model);
         self.model = model;
         self.failed_speed = None;
         // its workspace holds the old model's kernel spectra
@@ -252,13 +270,52 @@ impl Computer {
                 (values, f.steps, f.skipped_variance_fraction, f.quasi_static_components)
             })
         });
+        // the band and the trusted span (nothing trusted without the response table)
+        let opts = SpreadOptions {
+            model_error: job.model_error.clone(),
+            trusted_nrmse: self.trusted_nrmse,
+        };
+        let result = result.map(|(values, steps, dropped, quasi_static)| {
+            let spread = self.table.as_ref().map(|table| {
+                spread::spread(
+                    table,
+                    &job.waves,
+                    &job.known_leads,
+                    n_bodies,
+                    job.track.map_or(0.0, |t| t.speed_m_s),
+                    model.g_m_s2,
+                    model.water_depth_m,
+                    steps,
+                    model.opts.dt_s,
+                    &opts,
+                )
+            });
+            (values, steps, dropped, quasi_static, spread)
+        });
         let compute_ms = elapsed_ms();
         let mut header = job.header;
         header.compute_ms = compute_ms;
         header.issue_time_s = job.t0_s;
         match result {
-            Ok((values, steps, dropped_wave_share, quasi_static)) => {
+            Ok((mut values, steps, dropped_wave_share, quasi_static, spread)) => {
                 header.steps = steps as u32;
+                let mut motion_sigma = vec![];
+                match spread {
+                    Some(s) => {
+                        values.extend_from_slice(&s.sigma);
+                        for b in 0..n_bodies.min(MAX_VESSELS) {
+                            let ok = job.trustworthy.get(b).copied().unwrap_or(false) && s.to_s[b] > 0.0;
+                            header.horizon_s[b] = if ok { s.to_s[b] } else { 0.0 };
+                            header.trusted_from_s[b] = if ok { s.from_s[b] } else { 0.0 };
+                        }
+                        motion_sigma = s.motion_sigma;
+                    }
+                    None => {
+                        values.extend(std::iter::repeat_n(0.0, 6 * n_bodies * (steps + 1)));
+                        header.horizon_s = [0.0; MAX_VESSELS];
+                        header.trusted_from_s = [0.0; MAX_VESSELS];
+                    }
+                }
                 if quasi_static > 0 {
                     header.flags |= flags::QUASI_STATIC_WAVES;
                 }
@@ -268,6 +325,8 @@ impl Computer {
                     compute_ms,
                     error: None,
                     dropped_wave_share,
+                    motion_sigma,
+                    model_error: job.model_error,
                 }
             }
             Err(e) => Done {
@@ -276,9 +335,18 @@ impl Computer {
                 compute_ms,
                 error: Some(e.to_string()),
                 dropped_wave_share: 0.0,
+                motion_sigma: vec![],
+                model_error: job.model_error,
             },
         }
     }
+}
+
+/// The model's response table for the band, or None (logged) where its equations are singular.
+fn response_table(model: &TimeModel) -> Option<ResponseTable> {
+    ResponseTable::of(model)
+        .map_err(|e| tracing::warn!("no band for the forecasts (nothing will be trusted): {e}"))
+        .ok()
 }
 
 /// `SHIPCAST_FAULT=compute-panic` makes the compute thread panic on its first job: fault injection for
@@ -544,6 +612,10 @@ pub struct Engine {
     last_compute_ms: f64,
     last_horizon: [f64; MAX_VESSELS],
     state_flags: u32,
+    /// The model error learnt from past forecasts against the motion that followed, and the checks
+    /// at 30 s when it was last logged.
+    model_error: spread::ModelError,
+    model_error_logged: usize,
 }
 
 impl Engine {
@@ -603,6 +675,21 @@ impl Engine {
             last_compute_ms: 0.0,
             last_horizon: [0.0; MAX_VESSELS],
             state_flags: 0,
+            model_error_logged: 0,
+            model_error: spread::ModelError::new(
+                cfg.forecast.model_error,
+                // the motion sensor's noise as the estimator is told it (translations, rotations)
+                (0..6 * n_bodies)
+                    .map(|i| {
+                        let e = &cfg.estimator;
+                        if i % 6 < 3 {
+                            e.noise_m * e.noise_m
+                        } else {
+                            e.noise_rad * e.noise_rad
+                        }
+                    })
+                    .collect(),
+            ),
         }
     }
 
@@ -868,8 +955,41 @@ impl Engine {
                 }
             }
             if ok {
+                // past forecasts against the motion that followed them, as measured: with what the
+                // estimator takes for a sensor's bias (a forecast settles to the model's equilibrium, a
+                // moored vessel's static heel included, whatever its start)
+                let hist = &self.hist;
+                self.model_error.observe(t0, |t| {
+                    let mut x = vec![0.0; 6 * n_bodies];
+                    for (b, h) in hist.iter().enumerate() {
+                        let r = h.resample(t, dt, 0, cfg.max_gap_s)?;
+                        let bias = h.bias();
+                        for d in 0..6 {
+                            x[6 * b + d] = r.x0[d] + bias[d];
+                        }
+                    }
+                    Some(x)
+                });
+                // the learnt model error in the log: when first learnt, then every CHECK_MEMORY checks
+                let c30 = self.model_error.checks()[3];
+                if c30 != self.model_error_logged && (c30 == 60 || c30.is_multiple_of(600)) && c30 > 0 {
+                    self.model_error_logged = c30;
+                    let curve = self.model_error.curve();
+                    let at = |i: usize| {
+                        let m = curve.motion_var[i];
+                        format!("{:.3}", (curve.at(i, 30.0, m) / m).sqrt())
+                    };
+                    tracing::info!(
+                        checks = c30,
+                        "model error at 30 s lead (fraction of each measured motion; heave, roll, pitch per vessel): {}",
+                        (0..n_bodies)
+                            .map(|b| format!("[{} {} {}]", at(6 * b + 2), at(6 * b + 3), at(6 * b + 4)))
+                            .collect::<Vec<_>>()
+                            .join(" ")
+                    );
+                }
                 let mut header = ForecastHeader {
-                    schema_version: SCHEMA_VERSION,
+                    schema_version: crate::ipc::wire::FORECAST_SCHEMA_VERSION,
                     n_vessels: n_bodies as u32,
                     dt_s: dt,
                     n_series: (6 * n_bodies) as u32,
@@ -935,16 +1055,21 @@ impl Engine {
                     }
                     _ => true,
                 };
+                // each component's known leads at each vessel, from t0 (the field is that much older)
                 let (s, c) = heading.sin_cos();
-                for (b, r) in self.body_xy_m.iter().enumerate() {
-                    let p = [origin[0] + c * r[0] - s * r[1], origin[1] + s * r[0] + c * r[1]];
-                    let h = horizon::of_field(f, p, velocity, 0.0).horizon_s - (t0 - f.time_s).max(0.0);
-                    header.horizon_s[b] = if located && !untrusted && h.is_finite() {
-                        h.max(0.0)
-                    } else {
-                        0.0
-                    };
-                }
+                let age_s = (t0 - f.time_s).max(0.0);
+                let known_leads: Vec<Vec<[f64; 2]>> = self
+                    .body_xy_m
+                    .iter()
+                    .map(|r| {
+                        let p = [origin[0] + c * r[0] - s * r[1], origin[1] + s * r[0] + c * r[1]];
+                        horizon::known_leads(f, p, velocity)
+                            .into_iter()
+                            .map(|[a, b]| [a - age_s, b - age_s])
+                            .collect()
+                    })
+                    .collect();
+                let trustworthy = vec![located && !untrusted; n_bodies];
                 fl = header.flags;
                 self.busy = true;
                 job = Some(Job {
@@ -954,6 +1079,9 @@ impl Engine {
                     velocities,
                     known: known_history,
                     waves,
+                    known_leads,
+                    trustworthy,
+                    model_error: self.model_error.curve(),
                     track,
                     header,
                 });
@@ -976,9 +1104,20 @@ impl Engine {
                 }
                 if d.dropped_wave_share > self.cfg.max_dropped_wave_share {
                     header.horizon_s = [0.0; MAX_VESSELS];
+                    header.trusted_from_s = [0.0; MAX_VESSELS];
                 }
                 self.counters.forecasts += 1;
                 self.last_forecast_time = header.issue_time_s;
+                let n = (header.steps as usize + 1) * header.n_series as usize;
+                if values.len() == 2 * n {
+                    self.model_error.record(
+                        header.issue_time_s,
+                        header.dt_s,
+                        (&values[..n], &values[n..]),
+                        &d.motion_sigma,
+                        &d.model_error,
+                    );
+                }
                 self.last_horizon = header.horizon_s;
                 Some(Output::Forecast(header, values))
             }

@@ -39,8 +39,9 @@ pub enum Region {
     Everywhere,
     /// A disc (a radar's view), earth frame.
     Disc { centre_m: [f64; 2], radius_m: f64 },
-    /// A point (a wave probe).
-    Point { at_m: [f64; 2] },
+    /// A point (a wave probe) whose record of `window_s` seconds up to the field's time was fitted
+    /// (0: not said).
+    Point { at_m: [f64; 2], window_s: f64 },
     /// What a radar's valid cells covered, seen from `centre_m` (earth frame): in each of
     /// [`COVERAGE_SECTORS`] equal sectors of direction (sector j spans j..j+1 times 360 / sectors deg,
     /// counterclockwise from east), the farthest valid cell, m (0: nothing seen that way). A blind zone
@@ -94,7 +95,7 @@ pub struct WaveField {
 /// log (`record::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
 /// Radius 0 = no region known (read back as [`Region::Everywhere`]); a negative radius = a wave probe
 /// at the reference point ([`Region::Point`]; a probe's field is referred to its point); depth 0 =
-/// infinite.
+/// infinite. `window_s`: a probe's fitted record, s (0: not said, or not a probe).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlatHeader {
     pub time_s: f64,
@@ -102,6 +103,7 @@ pub struct FlatHeader {
     pub radius_m: f64,
     pub depth_m: f64,
     pub g_m_s2: f64,
+    pub window_s: f64,
 }
 
 /// Converts a compass heading (clockwise from north, degrees) to a direction counterclockwise from
@@ -152,6 +154,10 @@ impl WaveField {
             },
             depth_m: self.depth_m.unwrap_or(0.0),
             g_m_s2: self.g_m_s2,
+            window_s: match self.region {
+                Region::Point { window_s, .. } => window_s,
+                _ => 0.0,
+            },
         }
     }
 
@@ -184,7 +190,15 @@ impl WaveField {
                     radius_m: h.radius_m,
                 }
             } else if h.radius_m < 0.0 {
-                Region::Point { at_m: h.reference_m }
+                Region::Point {
+                    at_m: h.reference_m,
+                    // a window that is not a positive finite number is not said
+                    window_s: if h.window_s.is_finite() && h.window_s > 0.0 {
+                        h.window_s
+                    } else {
+                        0.0
+                    },
+                }
             } else {
                 Region::Everywhere
             },
@@ -364,7 +378,10 @@ mod tests {
                 centre_m: [100.0, -50.0],
                 radius_m: 800.0,
             },
-            Region::Point { at_m: [100.0, -50.0] },
+            Region::Point {
+                at_m: [100.0, -50.0],
+                window_s: 120.0,
+            },
         ] {
             let f = WaveField { region, ..field() };
             let back = WaveField::from_flat(f.flat_header(), f.flat_rows()).unwrap();

@@ -126,7 +126,7 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
                     rel,
                 ),
                 Region::Coverage { .. } => coverage_exit(&field.region, position_m, rel),
-                Region::Point { at_m } => {
+                Region::Point { at_m, .. } => {
                     // a probe: the group reaches the (stationary) vessel after travelling from it
                     let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
                     let closing = cg - (velocity_m_s[0] * d[0] + velocity_m_s[1] * d[1]);
@@ -141,6 +141,96 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
         })
         .collect();
     quantile(parts, noncausal_s)
+}
+
+/// Lead times (s, from the field's time) between which the water that brings a group of frequency w
+/// along d to a vessel at `position` (moving relative to the group at `rel`) had been inside a disc:
+/// the roots of |offset + rel t| = R, the earlier one no sooner than 0 ([0, 0]: never inside).
+fn disc_span(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> [f64; 2] {
+    let a = rel[0] * rel[0] + rel[1] * rel[1];
+    let b = offset[0] * rel[0] + offset[1] * rel[1];
+    let c = offset[0] * offset[0] + offset[1] * offset[1] - radius * radius;
+    if a <= 0.0 {
+        return if c <= 0.0 { [0.0, f64::INFINITY] } else { [0.0, 0.0] };
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return [0.0, 0.0];
+    }
+    let (t0, t1) = ((-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a);
+    if t1 < 0.0 { [0.0, 0.0] } else { [t0.max(0.0), t1] }
+}
+
+/// [`disc_span`] for a coverage region, marched as [`coverage_exit`] is: the first step inside, then
+/// the first outside after it ([0, 0]: never inside within reach).
+fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2]) -> [f64; 2] {
+    let Region::Coverage { ranges_m, centre_m } = region else {
+        return [0.0, 0.0];
+    };
+    let speed = rel[0].hypot(rel[1]);
+    if speed <= 0.0 {
+        return if region.contains(position) {
+            [0.0, f64::INFINITY]
+        } else {
+            [0.0, 0.0]
+        };
+    }
+    let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
+    let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
+    let dt = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS) / speed;
+    let at = |t: f64| region.contains([position[0] + rel[0] * t, position[1] + rel[1] * t]);
+    let mut t = 0.0;
+    while !at(t) {
+        t += dt;
+        if t * speed > reach {
+            return [0.0, 0.0];
+        }
+    }
+    let start = t;
+    while t * speed <= reach && at(t + dt) {
+        t += dt;
+    }
+    [start, t]
+}
+
+/// For each component of a field, the lead times (s, from the field's time) over which the waves it
+/// brings to a vessel at `position_m` moving at `velocity_m_s` (earth frame) had been observed:
+/// inside the observed disc or coverage at the field's time, or past the probe within its fitted
+/// window (a probe whose window is not said: from 0). Known everywhere: [0, infinity).
+pub fn known_leads(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2]) -> Vec<[f64; 2]> {
+    field
+        .components
+        .iter()
+        .map(|c| {
+            let cg = group_velocity(c.omega_rad_s, field.g_m_s2, field.depth_m);
+            let d = [c.direction_rad.cos(), c.direction_rad.sin()];
+            let rel = [velocity_m_s[0] - cg * d[0], velocity_m_s[1] - cg * d[1]];
+            match field.region {
+                Region::Everywhere => [0.0, f64::INFINITY],
+                Region::Disc { centre_m, radius_m } => disc_span(
+                    [position_m[0] - centre_m[0], position_m[1] - centre_m[1]],
+                    radius_m,
+                    rel,
+                ),
+                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel),
+                Region::Point { at_m, window_s } => {
+                    let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
+                    let closing = cg - (velocity_m_s[0] * d[0] + velocity_m_s[1] * d[1]);
+                    if along > 0.0 && closing > 0.0 {
+                        let arrive = along / closing;
+                        let start = if window_s > 0.0 {
+                            (arrive - window_s).max(0.0)
+                        } else {
+                            0.0
+                        };
+                        [start, arrive]
+                    } else {
+                        [0.0, 0.0]
+                    }
+                }
+            }
+        })
+        .collect()
 }
 
 /// A sea state for planning: JONSWAP (gamma = 1: Pierson-Moskowitz).
@@ -207,6 +297,95 @@ mod tests {
         assert!((disc_exit([600.0, 0.0], 1000.0, [5.0, 0.0]) - 80.0).abs() < 1e-9);
         // outside and moving away: never inside
         assert_eq!(disc_exit([2000.0, 0.0], 1000.0, [5.0, 0.0]), 0.0);
+    }
+
+    #[test]
+    fn known_leads_of_a_disc_a_probe_and_a_coverage() {
+        use crate::waves::field::{COVERAGE_SECTORS, FieldComponent};
+        let w = 0.6;
+        let cg = group_velocity(w, 9.81, None);
+        // waves travelling west (towards -x)
+        let comp = FieldComponent {
+            omega_rad_s: w,
+            direction_rad: PI,
+            amplitude_m: num_complex::Complex64::new(1.0, 0.0),
+        };
+        let field = |region| WaveField {
+            components: vec![comp],
+            reference_m: [0.0, 0.0],
+            time_s: 0.0,
+            g_m_s2: 9.81,
+            depth_m: None,
+            region,
+        };
+        // a disc of 1000 m around a stationary vessel at its centre: known from 0 to R / c_g
+        let k = known_leads(
+            &field(Region::Disc {
+                centre_m: [0.0, 0.0],
+                radius_m: 1000.0,
+            }),
+            [0.0, 0.0],
+            [0.0, 0.0],
+        );
+        assert!((k[0][0]).abs() < 1e-12 && (k[0][1] - 1000.0 / cg).abs() < 1e-9, "{k:?}");
+        // a vessel 1500 m down-wave of the disc's centre: from (1500 - 1000) / c_g to (1500 + 1000) / c_g
+        let k = known_leads(
+            &field(Region::Disc {
+                centre_m: [1500.0, 0.0],
+                radius_m: 1000.0,
+            }),
+            [0.0, 0.0],
+            [0.0, 0.0],
+        );
+        assert!(
+            (k[0][0] - 500.0 / cg).abs() < 1e-9 && (k[0][1] - 2500.0 / cg).abs() < 1e-9,
+            "{k:?}"
+        );
+        // a probe 600 m up-wave that fitted 30 s: the groups passing it arrive 600 / c_g later
+        let probe = |window_s| {
+            field(Region::Point {
+                at_m: [600.0, 0.0],
+                window_s,
+            })
+        };
+        let k = known_leads(&probe(30.0), [0.0, 0.0], [0.0, 0.0]);
+        assert!(
+            (k[0][1] - 600.0 / cg).abs() < 1e-9 && (k[0][0] - (600.0 / cg - 30.0)).abs() < 1e-9,
+            "{k:?}"
+        );
+        // a window longer than the travel: known from now
+        assert_eq!(known_leads(&probe(120.0), [0.0, 0.0], [0.0, 0.0])[0][0], 0.0);
+        let k = known_leads(&probe(0.0), [0.0, 0.0], [0.0, 0.0]);
+        assert_eq!(k[0][0], 0.0);
+        // down-wave of the vessel, a probe tells nothing
+        let k = known_leads(
+            &field(Region::Point {
+                at_m: [-600.0, 0.0],
+                window_s: 120.0,
+            }),
+            [0.0, 0.0],
+            [0.0, 0.0],
+        );
+        assert_eq!(k[0], [0.0, 0.0]);
+        // a coverage of 1000 m in every sector: as the disc, to a step
+        let cov = Region::Coverage {
+            centre_m: [0.0, 0.0],
+            ranges_m: [1000.0; COVERAGE_SECTORS],
+        };
+        let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
+        assert!(
+            k[0][0] == 0.0 && (k[0][1] - 1000.0 / cg).abs() < 10.0 / cg + 1e-9,
+            "{k:?}"
+        );
+        let cov = Region::Coverage {
+            centre_m: [1500.0, 0.0],
+            ranges_m: [1000.0; COVERAGE_SECTORS],
+        };
+        let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
+        assert!(
+            (k[0][0] - 500.0 / cg).abs() < 11.0 / cg && (k[0][1] - 2500.0 / cg).abs() < 11.0 / cg,
+            "{k:?}"
+        );
     }
 
     #[test]

@@ -430,7 +430,10 @@ pub fn from_probe(
         time_s: end_time_s,
         g_m_s2,
         depth_m,
-        region: Region::Point { at_m: position_m },
+        region: Region::Point {
+            at_m: position_m,
+            window_s: n as f64 * dt_s,
+        },
     };
     f.validate()?;
     Ok(f)

@@ -4,12 +4,14 @@
 Reads the daemon's `<prefix>/forecast` service over iceoryx2 (pip package `iceoryx2`, the same version
 as the crate: see requirements.txt) and decodes the payload documented in src/ipc/wire.rs:
 a ForecastHeader user header and a slice of f64, series-major, series s = 6 v + d (vessel v, DOF d in
-surge, sway, heave, roll, pitch, yaw), steps + 1 displacements each at issue_time_s + k dt_s.
+surge, sway, heave, roll, pitch, yaw), steps + 1 displacements each at issue_time_s + k dt_s, then
+as many standard deviations (the forecast's band) in the same order.
 
     python3 tools/console/subscriber.py --prefix shipcast --count 3
 
-Prints one JSON object per forecast: issue time, dt, horizon per vessel, flags, and the heave of each
-vessel at 0, 30 and 60 s ahead (a non-finite number is written as null). Waits up to --timeout seconds
+Prints one JSON object per forecast: issue time, dt, the trusted span per vessel (from, to), flags,
+and the heave of each vessel and its standard deviation at 0, 30 and 60 s ahead (a non-finite number
+is written as null). Waits up to --timeout seconds
 for the daemon's service to appear and for the forecasts; exits 1 with a one-line message if they do not,
 and skips (with a line on stderr) a payload whose header does not fit its data.
 """
@@ -23,7 +25,7 @@ import time
 
 import iceoryx2 as iox2
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 MAX_VESSELS = 4
 DOFS = ["surge", "sway", "heave", "roll", "pitch", "yaw"]
 FLAGS = [
@@ -41,11 +43,13 @@ FLAGS = [
     "clocks_disagree",
     "motion_implausible",
     "motion_restarted",
+    "navigation_fallback",
+    "quasi_static_waves",
 ]
 
 
 class ForecastHeader(ctypes.Structure):
-    """shipcast_ForecastHeader_v1 (96 bytes)."""
+    """shipcast_ForecastHeader_v2 (128 bytes)."""
 
     _fields_ = [
         ("schema_version", ctypes.c_uint32),
@@ -60,11 +64,12 @@ class ForecastHeader(ctypes.Structure):
         ("motion_time_s", ctypes.c_double),
         ("compute_ms", ctypes.c_double),
         ("horizon_s", ctypes.c_double * MAX_VESSELS),
+        ("trusted_from_s", ctypes.c_double * MAX_VESSELS),
     ]
 
     @staticmethod
     def type_name() -> str:
-        return "shipcast_ForecastHeader_v1"
+        return "shipcast_ForecastHeader_v2"
 
 
 def decode(header, payload) -> dict:
@@ -77,21 +82,32 @@ def decode(header, payload) -> dict:
     if not (math.isfinite(header.dt_s) and header.dt_s > 0.0):
         raise ValueError(f"dt_s {header.dt_s}")
     n = header.steps + 1
-    expected = header.n_series * n
+    # the displacements, then their standard deviations
+    expected = 2 * header.n_series * n
     count = payload.len()
     # iceoryx2 0.10's Python binding reports the length of a Rust `[f64]` slice in bytes: accept both
     if count not in (expected, 8 * expected):
-        raise ValueError(f"{count} values for {header.n_series} series of {n}")
+        raise ValueError(f"{count} values for {header.n_series} series of {n} and their standard deviations")
     values = list((ctypes.c_double * expected).from_address(payload.as_ptr()))
+    sigma0 = header.n_series * n
     vessels = []
     for v in range(header.n_vessels):
         heave = values[(6 * v + 2) * n:(6 * v + 3) * n]
-        at = {}
+        heave_sd = values[sigma0 + (6 * v + 2) * n:sigma0 + (6 * v + 3) * n]
+        at, sd = {}, {}
         for lead in (0.0, 30.0, 60.0):
             k = int(round(lead / header.dt_s))
             if k < n:
-                at[f"{lead:.0f}"] = heave[k]
-        vessels.append({"horizon_s": finite_or_none(header.horizon_s[v]), "heave_at_lead_s": at})
+                at[f"{lead:.0f}"] = finite_or_none(heave[k])
+                sd[f"{lead:.0f}"] = finite_or_none(heave_sd[k])
+        vessels.append(
+            {
+                "trusted_from_s": finite_or_none(header.trusted_from_s[v]),
+                "horizon_s": finite_or_none(header.horizon_s[v]),
+                "heave_at_lead_s": at,
+                "heave_sigma_at_lead_s": sd,
+            }
+        )
     return {
         "issue_time_s": header.issue_time_s,
         "dt_s": header.dt_s,

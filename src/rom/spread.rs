@@ -1,0 +1,707 @@
+//! How wide a forecast's band is and over which leads it is trusted (pure).
+//!
+//! A forecast knows a wave component only over the leads at which the water that brings it to the
+//! vessel had been observed (`waves::horizon::known_leads`: for a radar, while that water was inside
+//! the observed region at the observation time; for a probe, while it passed the probe within the
+//! fitted window). Outside that span the component the forecast carries is a guess whose phase is
+//! unrelated to the sea's, so the error it leaves has the variance of the forecast's and the sea's parts
+//! together: twice its own, [`UNKNOWN_ERROR_FACTOR`]. Each component's response variance is
+//! 0.5 |a|^2 |H(w_e, beta)|^2, H the model's own motion RAO (`TimeModel::implied_rao`: its radiation
+//! memory, damping, restoring, connections linearized) at the encounter frequency w_e = |w - k U cos beta|
+//! and the heading relative to the vessel. A component that becomes known only at a lead s > 0 (a
+//! probe far up-wave) leaves the response wrong for longer: the guess the forecast carried before s
+//! rings on in the motion for about the response's group delay tau = -d arg H / d w (at a resonance
+//! 1 / (zeta w_n), the decay time of its amplitude), so its error variance falls from its whole to
+//! nothing over s..s + tau, linearly (the area of exp(-2 (t - s) / tau)). The end of its span is not
+//! moved: the error of the waves after it grows from there. The standard deviation of each series
+//! at lead t is then
+//!
+//!   sigma^2(t) = 2 sum_c u_c(t) v_c + e^2 sum_c v_c,  u_c(t) = 1 unknown, 0 known, the ramp between
+//!
+//! with e the model error as a fraction of the motion's own standard deviation (config
+//! `forecast.model_error`, calibrated in replays: README). The ratio sigma(t) / sqrt(sum_c v_c) is the
+//! normalized RMS error the forecast expects at t; a vessel's forecast is trusted over the first run of
+//! leads at which that ratio is at most `forecast.trusted_nrmse` for each of heave, roll and pitch that
+//! moves enough to matter ([`SIGNIFICANT`]).
+//!
+//! Conventions (DESIGN.md section 1): DOF order surge, sway, heave, roll, pitch, yaw per vessel, m and
+//! rad; headings of waves relative to the vessel's +x, travel-to, counterclockwise; series-major output
+//! as on the wire (6 series per vessel, steps + 1 values each).
+
+use super::Result;
+use super::model::TimeModel;
+use crate::waves::WaveComponent;
+use std::f64::consts::TAU;
+
+/// Error variance of a component the forecast carries where it is not known, in units of its own
+/// response variance: the forecast's guess and the sea's unobserved part are independent.
+pub const UNKNOWN_ERROR_FACTOR: f64 = 2.0;
+
+/// The longest group delay of a response counted, s (a resonance with 1 % of critical damping at
+/// 1.6 rad/s; beyond, the delay is a phase jump where the response vanishes, not a memory).
+pub const MAX_GROUP_DELAY_S: f64 = 60.0;
+
+/// The response standard deviation below which heave (m), roll and pitch (rad) do not decide the
+/// trusted span: 1 cm, 0.1 deg (below what a motion sensor tells apart from its noise).
+pub const SIGNIFICANT: [f64; 3] = [0.01, 0.001_745, 0.001_745];
+
+/// Frequencies of the response table (uniform over the database's excitation range): fine enough for
+/// a roll resonance with 5 % of critical damping over a 0.2..2 rad/s range.
+const TABLE_OMEGAS: usize = 240;
+/// Headings of the response table (every 10 deg).
+const TABLE_HEADINGS: usize = 36;
+
+/// |H|^2 of every mode on a grid of frequency and relative heading, interpolated bilinearly (heading
+/// wrapping around the circle); zero outside the frequency range, as the forecast leaves out the waves
+/// the database does not cover.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResponseTable {
+    omega_rad_s: Vec<f64>,
+    n_modes: usize,
+    /// gain2[(iw * TABLE_HEADINGS + ib) * n_modes + i], m^2/m^2 or rad^2/m^2.
+    gain2: Vec<f64>,
+    /// The response's group delay, same layout, s (0..[`MAX_GROUP_DELAY_S`]).
+    delay_s: Vec<f64>,
+}
+
+impl ResponseTable {
+    /// The table of a model's own response (`TimeModel::implied_rao`).
+    pub fn of(model: &TimeModel) -> Result<ResponseTable> {
+        let ws = &model.db.exc_omega_rad_s;
+        let (w0, w1) = (ws[0], ws[ws.len() - 1]);
+        let omega_rad_s: Vec<f64> = (0..TABLE_OMEGAS)
+            .map(|i| w0 + (w1 - w0) * i as f64 / (TABLE_OMEGAS - 1) as f64)
+            .collect();
+        let n_modes = model.n_modes;
+        let mut rao = Vec::with_capacity(TABLE_OMEGAS * TABLE_HEADINGS * n_modes);
+        for &w in &omega_rad_s {
+            let k = model.kernel_at(w);
+            for ib in 0..TABLE_HEADINGS {
+                let beta = TAU * ib as f64 / TABLE_HEADINGS as f64;
+                rao.extend(model.implied_rao_with(&k, w, beta)?);
+            }
+        }
+        let gain2 = rao.iter().map(|r| r.norm_sqr()).collect();
+        // -d arg H / d w by the phase change between neighbouring frequencies (one-sided at the ends)
+        let at = |iw: usize, ib: usize, i: usize| rao[(iw * TABLE_HEADINGS + ib) * n_modes + i];
+        let dw = omega_rad_s[1] - omega_rad_s[0];
+        let mut delay_s = Vec::with_capacity(rao.len());
+        for iw in 0..TABLE_OMEGAS {
+            let (lo, hi) = (iw.saturating_sub(1), (iw + 1).min(TABLE_OMEGAS - 1));
+            for ib in 0..TABLE_HEADINGS {
+                for i in 0..n_modes {
+                    let turn = (at(hi, ib, i) * at(lo, ib, i).conj()).arg();
+                    let d = -turn / ((hi - lo) as f64 * dw);
+                    delay_s.push(if d.is_finite() {
+                        d.clamp(0.0, MAX_GROUP_DELAY_S)
+                    } else {
+                        0.0
+                    });
+                }
+            }
+        }
+        Ok(ResponseTable {
+            omega_rad_s,
+            n_modes,
+            gain2,
+            delay_s,
+        })
+    }
+
+    /// |H|^2 of every mode at a frequency and a relative heading into `gain2`, and the group delay
+    /// into `delay_s` (n_modes values each).
+    pub fn gain2_into(&self, omega_rad_s: f64, heading_rad: f64, gain2: &mut [f64], delay_s: &mut [f64]) {
+        gain2.fill(0.0);
+        delay_s.fill(0.0);
+        let ws = &self.omega_rad_s;
+        if !(omega_rad_s >= ws[0] && omega_rad_s <= ws[ws.len() - 1] && heading_rad.is_finite()) {
+            return;
+        }
+        let dw = ws[1] - ws[0];
+        let fw = ((omega_rad_s - ws[0]) / dw).min((ws.len() - 1) as f64 - 1e-12);
+        let iw = fw.floor() as usize;
+        let aw = fw - iw as f64;
+        let fb = heading_rad.rem_euclid(TAU) / TAU * TABLE_HEADINGS as f64;
+        let ib = (fb.floor() as usize).min(TABLE_HEADINGS - 1);
+        let ab = fb - ib as f64;
+        let ib1 = (ib + 1) % TABLE_HEADINGS;
+        let n = self.n_modes;
+        for (wi, wa) in [(iw, 1.0 - aw), (iw + 1, aw)] {
+            for (bi, ba) in [(ib, 1.0 - ab), (ib1, ab)] {
+                let c = wa * ba;
+                if c == 0.0 {
+                    continue;
+                }
+                let at = (wi * TABLE_HEADINGS + bi) * n;
+                for (o, g) in gain2.iter_mut().zip(&self.gain2[at..at + n]) {
+                    *o += c * g;
+                }
+                for (o, d) in delay_s.iter_mut().zip(&self.delay_s[at..at + n]) {
+                    *o += c * d;
+                }
+            }
+        }
+    }
+}
+
+/// What decides a band's width and the trusted span.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpreadOptions {
+    /// Model error of each series against lead, as a fraction of its standard deviation
+    /// ([`ModelError`]).
+    pub model_error: ModelErrorCurve,
+    /// The expected normalized RMS error up to which a lead is trusted (`forecast.trusted_nrmse`).
+    pub trusted_nrmse: f64,
+}
+
+/// A forecast's band and trusted span.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spread {
+    /// Standard deviation of every series at every step, series-major (6 per vessel, m or rad).
+    pub sigma: Vec<f64>,
+    /// Per vessel, the first and the last lead of the trusted span, s (both 0: not trusted at all).
+    pub from_s: Vec<f64>,
+    pub to_s: Vec<f64>,
+    /// Per series, the response's own standard deviation, m or rad.
+    pub motion_sigma: Vec<f64>,
+}
+
+/// The band and span of a forecast of `steps` steps of `dt_s` from `waves` (relative to the vessels'
+/// frame, as the forecast takes them); `known[b][c]` is the span of leads (s, from the forecast's
+/// start) over which component c is known at vessel b; `speed_m_s` along the vessels' +x gives the
+/// encounter frequency.
+#[allow(clippy::too_many_arguments)]
+pub fn spread(
+    table: &ResponseTable,
+    waves: &[WaveComponent],
+    known: &[Vec<[f64; 2]>],
+    n_bodies: usize,
+    speed_m_s: f64,
+    g_m_s2: f64,
+    depth_m: Option<f64>,
+    steps: usize,
+    dt_s: f64,
+    opts: &SpreadOptions,
+) -> Spread {
+    let n = steps + 1;
+    let n_series = 6 * n_bodies;
+    // per series: the total response variance, and difference arrays of the unknown variance, a
+    // constant part and a part proportional to the step (the ramps)
+    let mut total = vec![0.0; n_series];
+    let mut diff = vec![vec![0.0; n + 1]; n_series];
+    let mut slope = vec![vec![0.0; n + 1]; n_series];
+    let mut g2 = vec![0.0; table.n_modes];
+    let mut delay = vec![0.0; table.n_modes];
+    let step = |t: f64| -> usize {
+        if t.is_nan() || t <= 0.0 {
+            0
+        } else {
+            ((t / dt_s).ceil() as usize).min(n)
+        }
+    };
+    for (c, w) in waves.iter().enumerate() {
+        let v = 0.5 * w.amplitude_m.norm_sqr();
+        if !(v.is_finite() && v > 0.0) {
+            continue;
+        }
+        let k = crate::waves::wave_number(w.omega_rad_s, g_m_s2, depth_m);
+        let we = (w.omega_rad_s - k * speed_m_s * w.heading_rad.cos()).abs();
+        table.gain2_into(we, w.heading_rad, &mut g2, &mut delay);
+        for b in 0..n_bodies.min(table.n_modes / 6) {
+            let [s, e] = known.get(b).and_then(|k| k.get(c)).copied().unwrap_or([0.0, 0.0]);
+            for d in 0..6 {
+                let i = 6 * b + d;
+                let vr = v * g2[i];
+                if vr.is_nan() || vr <= 0.0 {
+                    continue;
+                }
+                // known over steps ks..ke (exclusive), unknown before and after; a start after the
+                // forecast's own rings on over kr steps (ramping down to known)
+                let ks = step(s);
+                let ke = if e.is_finite() {
+                    step(e + 1e-9 * dt_s).max(ks)
+                } else {
+                    n
+                };
+                let ke = if e >= s { ke } else { ks };
+                let kr = if s > 0.0 {
+                    ((delay[i] / dt_s).round() as usize).min(ke - ks)
+                } else {
+                    0
+                };
+                total[i] += vr;
+                let u = UNKNOWN_ERROR_FACTOR * vr;
+                diff[i][0] += u;
+                diff[i][ks] -= u;
+                diff[i][ke] += u;
+                diff[i][n] -= u;
+                if kr > 0 {
+                    // u (1 - (k - ks) / kr) over ks..ks + kr: u (1 + ks / kr) - (u / kr) k
+                    let rate = u / kr as f64;
+                    diff[i][ks] += u + rate * ks as f64;
+                    diff[i][ks + kr] -= u + rate * ks as f64;
+                    slope[i][ks] -= rate;
+                    slope[i][ks + kr] += rate;
+                }
+            }
+        }
+    }
+    let mut sigma = Vec::with_capacity(n_series * n);
+    for i in 0..n_series {
+        let (mut acc, mut rate) = (0.0, 0.0);
+        for (k, (dk, dr)) in diff[i][..n].iter().zip(&slope[i][..n]).enumerate() {
+            let floor = opts.model_error.at(i, k as f64 * dt_s, total[i]);
+            acc += dk;
+            rate += dr;
+            sigma.push(((acc + rate * k as f64).max(0.0) + floor).sqrt());
+        }
+    }
+    let motion_sigma: Vec<f64> = total.iter().map(|t| t.sqrt()).collect();
+    // the span judges the expected error against the motion as measured where it is known (a
+    // linearized model may not move as the vessel does)
+    let judged: Vec<f64> = (0..n_series)
+        .map(|i| opts.model_error.motion_sigma(i, motion_sigma[i]))
+        .collect();
+    let mut from_s = vec![0.0; n_bodies];
+    let mut to_s = vec![0.0; n_bodies];
+    for b in 0..n_bodies {
+        let decisive: Vec<usize> = (0..3)
+            .filter(|&j| judged[6 * b + 2 + j] >= SIGNIFICANT[j])
+            .map(|j| 6 * b + 2 + j)
+            .collect();
+        let trusted = |k: usize| {
+            decisive
+                .iter()
+                .all(|&i| sigma[i * n + k] <= opts.trusted_nrmse * judged[i])
+        };
+        if let Some(first) = (0..n).find(|&k| trusted(k)) {
+            let last = (first..n).take_while(|&k| trusted(k)).last().unwrap_or(first);
+            from_s[b] = first as f64 * dt_s;
+            to_s[b] = last as f64 * dt_s;
+        }
+    }
+    Spread {
+        sigma,
+        from_s,
+        to_s,
+        motion_sigma,
+    }
+}
+
+/// The leads at which past forecasts are checked against the motion that followed, s (those within
+/// the forecast's length): the model error is learnt as a function of lead.
+pub const CHECK_LEADS_S: [f64; 12] = [
+    5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0, 180.0, 300.0,
+];
+/// The prior model error (`forecast.model_error`) holds up to this lead and grows in proportion
+/// beyond it, as a phase error does (an inversion's frequency error): until the daemon has checked
+/// its forecasts at a lead, it does not take them for better than that, s.
+pub const PRIOR_LEAD_S: f64 = 30.0;
+/// Checks averaged over: the model error follows the sea over about this many forecasts.
+pub const CHECK_MEMORY: f64 = 600.0;
+/// Checks at a lead before its estimate replaces the configured prior.
+pub const CHECK_MIN: usize = 60;
+/// The smallest model error the estimate gives (a forecast is never taken as perfect).
+const MIN_MODEL_ERROR: f64 = 0.02;
+/// A series is learnt only where the measured motion's variance is this many times the sensor's
+/// noise variance (a motion buried in noise tells nothing of the forecast's error: the prior stays).
+const MIN_SIGNAL_TO_NOISE: f64 = 9.0;
+
+/// A forecast waiting to be checked: at each check lead (the first `values.len()` of
+/// [`CHECK_LEADS_S`]), its values there and the variance of the waves it did not know.
+#[derive(Debug, Clone, PartialEq)]
+struct Pending {
+    issue_s: f64,
+    dt_s: f64,
+    /// The next check lead to do.
+    next: usize,
+    /// [lead][series]
+    values: Vec<Vec<f64>>,
+    unknown_var: Vec<Vec<f64>>,
+}
+
+/// The model error each series shows against lead, learnt from past forecasts checked against the
+/// motion that followed: at each of [`CHECK_LEADS_S`], the squared error less what the waves the
+/// forecast did not know and the motion sensor's own noise explain, averaged over the last
+/// [`CHECK_MEMORY`] checks (until [`CHECK_MIN`] of them, a configured fraction of the motion
+/// instead); and the motion's own variance, as measured. It takes in what a wave-by-wave account
+/// leaves out: the model's own error, the inversion's frequency error that grows with lead, the
+/// initial state's. Pure: forecasts and measurements in, variances out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelError {
+    prior: f64,
+    n_series: usize,
+    /// Per series, the variance of the measurement's noise (the band is for the motion, not the
+    /// sensor's reading of it).
+    noise_var: Vec<f64>,
+    pending: std::collections::VecDeque<Pending>,
+    /// [lead][series]: running mean of error^2 less what is explained.
+    excess: Vec<Vec<f64>>,
+    /// Checks done at each lead.
+    checks: Vec<usize>,
+    /// Per series, running mean and mean square of the measured motion (at the checks of the first
+    /// lead), and how many.
+    mean: Vec<f64>,
+    square: Vec<f64>,
+    samples: usize,
+}
+
+/// The model error of each series against lead, and the motion's measured variance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelErrorCurve {
+    pub lead_s: Vec<f64>,
+    /// `var[series][lead]`, m^2 or rad^2 (NaN: not learnt, the prior's fraction of the motion).
+    pub var: Vec<Vec<f64>>,
+    /// The fraction of a series' motion standard deviation taken where nothing is learnt.
+    pub prior: f64,
+    /// Per series, the motion's measured variance (NaN: not yet known).
+    pub motion_var: Vec<f64>,
+    /// Per series, the motion sensor's noise variance: no band is narrower (a motion buried in the
+    /// noise is forecast from a start the noise has moved).
+    pub noise_var: Vec<f64>,
+}
+
+impl ModelErrorCurve {
+    /// Nothing learnt: `fraction` of each series' motion.
+    pub fn prior(fraction: f64, n_series: usize) -> ModelErrorCurve {
+        ModelErrorCurve {
+            lead_s: vec![0.0],
+            var: vec![vec![f64::NAN]; n_series],
+            prior: fraction,
+            motion_var: vec![f64::NAN; n_series],
+            noise_var: vec![0.0; n_series],
+        }
+    }
+
+    /// Series i's model error variance at `lead_s`, its model's motion variance being
+    /// `model_motion_var`: linear between the check leads, constant beyond them.
+    pub fn at(&self, i: usize, lead_s: f64, model_motion_var: f64) -> f64 {
+        let noise = self.noise_var.get(i).copied().unwrap_or(0.0);
+        self.learnt_at(i, lead_s, model_motion_var).max(noise)
+    }
+
+    fn learnt_at(&self, i: usize, lead_s: f64, model_motion_var: f64) -> f64 {
+        let grown = self.prior * (lead_s / PRIOR_LEAD_S).max(1.0);
+        let prior = grown * grown * model_motion_var;
+        let Some(f) = self.var.get(i) else {
+            return prior;
+        };
+        let v = |j: usize| f.get(j).copied().filter(|x| x.is_finite()).unwrap_or(prior);
+        let l = &self.lead_s;
+        let j = l.partition_point(|x| *x <= lead_s);
+        if j == 0 {
+            return v(0);
+        }
+        if j >= l.len() {
+            return v(l.len() - 1);
+        }
+        let a = (lead_s - l[j - 1]) / (l[j] - l[j - 1]);
+        v(j - 1) + a * (v(j) - v(j - 1))
+    }
+
+    /// Series i's motion standard deviation: measured, else the model's.
+    pub fn motion_sigma(&self, i: usize, model_sigma: f64) -> f64 {
+        self.motion_var
+            .get(i)
+            .filter(|v| v.is_finite())
+            .map_or(model_sigma, |v| v.sqrt())
+    }
+}
+
+impl ModelError {
+    /// A prior fraction for every series, and each series' measurement noise variance (its length is
+    /// the number of series).
+    pub fn new(prior: f64, noise_var: Vec<f64>) -> ModelError {
+        let n_series = noise_var.len();
+        ModelError {
+            prior,
+            n_series,
+            noise_var,
+            pending: Default::default(),
+            excess: vec![vec![0.0; n_series]; CHECK_LEADS_S.len()],
+            checks: vec![0; CHECK_LEADS_S.len()],
+            mean: vec![0.0; n_series],
+            square: vec![0.0; n_series],
+            samples: 0,
+        }
+    }
+
+    /// Checks done so far at each of [`CHECK_LEADS_S`].
+    pub fn checks(&self) -> &[usize] {
+        &self.checks
+    }
+
+    /// What has been learnt.
+    pub fn curve(&self) -> ModelErrorCurve {
+        let var = (0..self.n_series)
+            .map(|i| {
+                (0..CHECK_LEADS_S.len())
+                    .map(|j| {
+                        let motion = self.motion_var(i);
+                        if self.checks[j] < CHECK_MIN || motion.is_nan() {
+                            return f64::NAN;
+                        }
+                        // never below MIN_MODEL_ERROR of the motion
+                        self.excess[j][i].max(MIN_MODEL_ERROR * MIN_MODEL_ERROR * motion)
+                    })
+                    .collect()
+            })
+            .collect();
+        ModelErrorCurve {
+            lead_s: CHECK_LEADS_S.to_vec(),
+            var,
+            prior: self.prior,
+            motion_var: (0..self.n_series).map(|i| self.motion_var(i)).collect(),
+            noise_var: self.noise_var.clone(),
+        }
+    }
+
+    /// Series i's measured motion variance, less the sensor's noise (NaN before [`CHECK_MIN`], or
+    /// when it is below [`MIN_SIGNAL_TO_NOISE`] times the noise).
+    fn motion_var(&self, i: usize) -> f64 {
+        let total = self.square[i] - self.mean[i] * self.mean[i];
+        if self.samples < CHECK_MIN || total < MIN_SIGNAL_TO_NOISE * self.noise_var[i] {
+            return f64::NAN;
+        }
+        total - self.noise_var[i]
+    }
+
+    /// A forecast issued at `issue_s` (values and standard deviations series-major, `steps + 1` each,
+    /// step `dt_s`), each series' motion standard deviation by the model, and the model error it was
+    /// made with.
+    pub fn record(
+        &mut self,
+        issue_s: f64,
+        dt_s: f64,
+        spread: (&[f64], &[f64]),
+        model_motion_sigma: &[f64],
+        used: &ModelErrorCurve,
+    ) {
+        let (values, sigma) = spread;
+        let ns = self.n_series;
+        if !(dt_s > 0.0 && issue_s.is_finite())
+            || model_motion_sigma.len() != ns
+            || sigma.len() != values.len()
+            || ns == 0
+        {
+            return;
+        }
+        let n = values.len() / ns;
+        let mut p = Pending {
+            issue_s,
+            dt_s,
+            next: 0,
+            values: vec![],
+            unknown_var: vec![],
+        };
+        for &lead in &CHECK_LEADS_S {
+            let k = (lead / dt_s).round() as usize;
+            if k >= n {
+                break;
+            }
+            p.values.push((0..ns).map(|i| values[i * n + k]).collect());
+            p.unknown_var.push(
+                (0..ns)
+                    .map(|i| {
+                        let floor = used.at(i, lead, model_motion_sigma[i] * model_motion_sigma[i]);
+                        (sigma[i * n + k].powi(2) - floor).max(0.0)
+                    })
+                    .collect(),
+            );
+        }
+        if !p.values.is_empty() {
+            self.pending.push_back(p);
+        }
+    }
+
+    /// Checks every pending forecast at each of its check leads that `now_s` has passed, against
+    /// `measured(t)`: every series' displacement at t (None: not measured, that check is skipped).
+    pub fn observe(&mut self, now_s: f64, mut measured: impl FnMut(f64) -> Option<Vec<f64>>) {
+        for p in &mut self.pending {
+            while p.next < p.values.len() {
+                let k = (CHECK_LEADS_S[p.next] / p.dt_s).round();
+                let t = p.issue_s + k * p.dt_s;
+                if t > now_s {
+                    break;
+                }
+                let j = p.next;
+                p.next += 1;
+                let Some(x) = measured(t).filter(|x| x.len() == self.n_series && x.iter().all(|v| v.is_finite()))
+                else {
+                    continue;
+                };
+                self.checks[j] += 1;
+                let w = 1.0 / (self.checks[j] as f64).min(CHECK_MEMORY);
+                for (i, xi) in x.iter().enumerate() {
+                    let e2 = (xi - p.values[j][i]).powi(2);
+                    let explained = p.unknown_var[j][i] + self.noise_var[i];
+                    self.excess[j][i] += w * (e2 - explained - self.excess[j][i]);
+                }
+                if j == 0 {
+                    self.samples += 1;
+                    let w = 1.0 / (self.samples as f64).min(CHECK_MEMORY);
+                    for (i, xi) in x.iter().enumerate() {
+                        self.mean[i] += w * (xi - self.mean[i]);
+                        self.square[i] += w * (xi * xi - self.square[i]);
+                    }
+                }
+            }
+        }
+        while self.pending.front().is_some_and(|p| p.next >= p.values.len()) {
+            self.pending.pop_front();
+        }
+    }
+}
+
+/// The standard normal distribution's cumulative probability.
+pub fn normal_cdf(z: f64) -> f64 {
+    0.5 * libm::erfc(-z / std::f64::consts::SQRT_2)
+}
+
+/// The probability that a normal variable of mean `mean` and standard deviation `sigma` lies outside
+/// [-limit, limit] (0 or 1 for sigma 0).
+pub fn exceedance(mean: f64, sigma: f64, limit: f64) -> f64 {
+    if sigma.is_nan() || sigma <= 0.0 {
+        return if mean.abs() > limit { 1.0 } else { 0.0 };
+    }
+    normal_cdf((-limit - mean) / sigma) + normal_cdf((mean - limit) / sigma)
+}
+
+/// The half-width of a two-sided band holding `probability` of a normal variable, in standard
+/// deviations (1.645 for 0.9), by bisection on [`normal_cdf`].
+pub fn band_z(probability: f64) -> f64 {
+    let target = 0.5 + 0.5 * probability.clamp(0.0, 1.0 - 1e-12);
+    let (mut lo, mut hi) = (0.0, 10.0);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if normal_cdf(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_complex::Complex64;
+
+    fn flat_table(n_modes: usize, gain: f64) -> ResponseTable {
+        ResponseTable {
+            omega_rad_s: vec![0.2, 2.0],
+            n_modes,
+            gain2: vec![gain * gain; 2 * TABLE_HEADINGS * n_modes],
+            delay_s: vec![5.0; 2 * TABLE_HEADINGS * n_modes],
+        }
+    }
+
+    #[test]
+    fn the_model_error_is_learnt_against_lead_from_past_forecasts_less_the_unknown_waves() {
+        // one series whose model motion has sigma 1; forecasts of 0 with a band of 0.6 (0.5 of it
+        // unknown waves: 0.6^2 = 0.25 + 0.33^2 ~ 0.36); the motion then shows an error of 0.7 at
+        // every lead: 0.49 - 0.25 = 0.24 is the model's
+        let mut m = ModelError::new(0.33, vec![0.0]);
+        let prior = ModelErrorCurve::prior(0.33, 1);
+        assert!(m.curve().var[0].iter().all(|v| v.is_nan()));
+        let dt = 0.5;
+        let n = 61; // 30 s: checked at 5, 10, 20 and 30 s
+        let values = vec![0.0; n];
+        let sigma = vec![(0.25f64 + 0.33 * 0.33).sqrt(); n];
+        // checks fall on whole seconds: the motion alternates between them
+        let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.7 } else { -0.7 };
+        for j in 0..200 {
+            let t = j as f64;
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior);
+            m.observe(t, |at| Some(vec![truth(at)]));
+        }
+        assert!(m.checks()[..4].iter().all(|c| *c >= CHECK_MIN), "{:?}", m.checks());
+        assert_eq!(m.checks()[4], 0);
+        let c = m.curve();
+        for j in 0..4 {
+            assert!((c.var[0][j] - 0.24).abs() < 0.01, "{:?}", c.var);
+        }
+        // the motion as measured: 0.7 either way
+        assert!((c.motion_var[0] - 0.49).abs() < 0.01, "{:?}", c.motion_var);
+        assert!((c.motion_sigma(0, 1.0) - 0.7).abs() < 0.01);
+        // unchecked leads keep the prior (0.33 of the model's motion, growing in proportion to the
+        // lead beyond 30 s, taken at the lead asked); between check leads linear
+        assert!(c.var[0][5].is_nan());
+        assert!((c.at(0, 60.0, 1.0) - 0.66 * 0.66).abs() < 1e-12);
+        assert!((c.at(0, 37.5, 1.0) - 0.5 * (0.24 + (0.33f64 * 1.25).powi(2))).abs() < 0.01);
+        // a motion that is not there, or not finite, is no check
+        let before = m.checks().to_vec();
+        m.record(300.0, dt, (&values, &sigma), &[1.0], &prior);
+        m.observe(400.0, |_| Some(vec![f64::NAN]));
+        m.observe(400.0, |_| None);
+        assert_eq!(m.checks(), &before[..]);
+    }
+
+    #[test]
+    fn normal_quantiles() {
+        assert!((normal_cdf(0.0) - 0.5).abs() < 1e-15);
+        assert!((band_z(0.9) - 1.644_853_6).abs() < 1e-6);
+        assert!((band_z(0.95) - 1.959_964).abs() < 1e-6);
+        assert!((exceedance(0.0, 1.0, 1.644_853_6) - 0.1).abs() < 1e-7);
+        assert_eq!(exceedance(2.0, 0.0, 1.0), 1.0);
+    }
+
+    #[test]
+    fn the_band_widens_where_components_are_unknown_and_the_span_is_where_the_expected_error_is_small() {
+        // two equal components of heave gain 1: one known over 0..60 s, the other over 20..40 s
+        let table = flat_table(6, 1.0);
+        let a = Complex64::new(1.0, 0.0);
+        let waves = [
+            WaveComponent {
+                omega_rad_s: 0.6,
+                heading_rad: std::f64::consts::PI,
+                amplitude_m: a,
+            },
+            WaveComponent {
+                omega_rad_s: 0.8,
+                heading_rad: std::f64::consts::PI,
+                amplitude_m: a,
+            },
+        ];
+        let known = vec![vec![[0.0, 60.0], [20.0, 40.0]]];
+        let opts = SpreadOptions {
+            model_error: ModelErrorCurve::prior(0.1, 6),
+            trusted_nrmse: 0.6,
+        };
+        let s = spread(&table, &waves, &known, 1, 0.0, 9.81, None, 100, 1.0, &opts);
+        let heave = &s.sigma[2 * 101..3 * 101];
+        // each component 0.5 m^2; unknown: 2 x 0.5 each; the prior floor 0.1^2 of the motion's 1.0
+        // up to 30 s, then growing in proportion to the lead
+        let expect = |unknown: f64| (unknown + 0.01_f64).sqrt();
+        let expect_at = |unknown: f64, lead: f64| (unknown + (0.1 * lead / PRIOR_LEAD_S).powi(2)).sqrt();
+        assert!((heave[10] - expect(1.0)).abs() < 1e-12);
+        assert!((heave[30] - expect(0.0)).abs() < 1e-12);
+        assert!((heave[50] - expect_at(1.0, 50.0)).abs() < 1e-12);
+        assert!((heave[80] - expect_at(2.0, 80.0)).abs() < 1e-12);
+        // the second one's start rings on over the response's 5 s memory: its error falls linearly
+        // over 20..25 s; expected NRMSE at 10 s sqrt(1.01) > 0.6, at 30 s 0.1; at 23 s sqrt(0.41) >
+        // 0.6, at 24 s sqrt(0.21): trusted 24..40 s
+        assert!((heave[22] - expect(0.6)).abs() < 1e-12, "{}", heave[22]);
+        assert!((heave[25] - expect(0.0)).abs() < 1e-12);
+        assert_eq!((s.from_s[0], s.to_s[0]), (24.0, 40.0));
+        assert!((s.motion_sigma[2] - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_calm_vessel_is_trusted_throughout_and_garbage_amplitudes_are_left_out() {
+        let table = flat_table(6, 1.0);
+        let waves = [WaveComponent {
+            omega_rad_s: 0.6,
+            heading_rad: 0.0,
+            amplitude_m: Complex64::new(f64::NAN, 0.0),
+        }];
+        let opts = SpreadOptions {
+            model_error: ModelErrorCurve::prior(0.1, 6),
+            trusted_nrmse: 0.6,
+        };
+        let s = spread(&table, &waves, &[vec![[0.0, 0.0]]], 1, 0.0, 9.81, None, 10, 1.0, &opts);
+        assert!(s.sigma.iter().all(|x| *x == 0.0));
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 10.0));
+    }
+}
