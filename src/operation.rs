@@ -412,31 +412,49 @@ pub fn score_windows(forecast: &[Window], actual: &[Window], duration_s: f64) ->
     s
 }
 
-/// One forecast's operator windows against the motion measured over its trusted span: channel values
-/// of the forecast (`forecast[s]`: series s, 6 per vessel, at t0 + k dt) and of the measurement
-/// (`measured[s]`: sorted (t, value) of series s), windows of each, matched by [`score_windows`]. None
-/// when the measurement does not cover the span.
-#[allow(clippy::too_many_arguments)]
+/// A forecast as [`score_forecast_windows`] takes it: series s (6 per vessel) at t0 + k dt, each
+/// value's standard deviation (`sigma`, same layout; empty: none), and the trusted span (lead s).
+#[derive(Debug, Clone, Copy)]
+pub struct SpanForecast<'a> {
+    pub t0_s: f64,
+    pub dt_s: f64,
+    pub values: &'a [&'a [f64]],
+    pub sigma: &'a [&'a [f64]],
+    pub trusted_from_s: f64,
+    pub trusted_s: f64,
+}
+
+/// One forecast's operator windows against the motion measured over its trusted span, as the console
+/// judges them (a step is quiet when every channel is inside its limit with `confidence` by the band):
+/// channel values of the forecast and of the measurement (`measured[s]`: sorted (t, value) of series
+/// s), windows of each, matched by [`score_windows`]. None when the measurement does not cover the
+/// span.
 pub fn score_forecast_windows(
     channels: &[Channel],
     ext: &External,
-    t0_s: f64,
-    dt_s: f64,
-    forecast: &[&[f64]],
+    f: &SpanForecast,
     measured: &[Vec<(f64, f64)>],
-    trusted_s: f64,
     duration_s: f64,
+    confidence: f64,
 ) -> Option<WindowScore> {
+    let (t0_s, dt_s, forecast) = (f.t0_s, f.dt_s, f.values);
     let n = forecast.iter().map(|s| s.len()).min()?;
-    let m = trusted_samples(n, dt_s, trusted_s);
-    if m < 2 || measured.len() < forecast.len() {
+    let m = trusted_samples(n, dt_s, f.trusted_s);
+    let first = ((f.trusted_from_s / dt_s - 1e-9).ceil().max(0.0) as usize).min(m);
+    if m < first + 2 || measured.len() < forecast.len() {
         return None;
     }
-    let span: Vec<&[f64]> = forecast.iter().map(|s| &s[..m]).collect();
+    let span: Vec<&[f64]> = forecast.iter().map(|s| &s[first..m]).collect();
     let vf: Vec<Vec<f64>> = channels.iter().map(|ch| ch.along(ext, &span)).collect();
+    let bands: Vec<Vec<f64>> = if f.sigma.len() == forecast.len() && f.sigma.iter().all(|s| s.len() >= m) {
+        let span: Vec<&[f64]> = f.sigma.iter().map(|s| &s[first..m]).collect();
+        channels.iter().map(|ch| ch.sigma_along(ext, &span)).collect()
+    } else {
+        vec![vec![]; channels.len()]
+    };
     let mut xm = vec![0.0; forecast.len()];
-    let mut vm = vec![Vec::with_capacity(m); channels.len()];
-    for k in 0..m {
+    let mut vm = vec![Vec::with_capacity(m - first); channels.len()];
+    for k in first..m {
         let t = t0_s + k as f64 * dt_s;
         for s in 0..forecast.len() {
             xm[s] = crate::skill::interpolate(&measured[s], t)?;
@@ -446,12 +464,17 @@ pub fn score_forecast_windows(
         }
     }
     let limits: Vec<f64> = channels.iter().map(|c| c.limit).collect();
-    let view = |v: &[Vec<f64>]| -> Vec<bool> {
-        let refs: Vec<&[f64]> = v.iter().map(|x| x.as_slice()).collect();
-        inside(&refs, &limits)
-    };
-    let wf = windows(t0_s, dt_s, &view(&vf), duration_s);
-    let wm = windows(t0_s, dt_s, &view(&vm), duration_s);
+    let fv: Vec<&[f64]> = vf.iter().map(|x| x.as_slice()).collect();
+    let fb: Vec<&[f64]> = bands.iter().map(|x| x.as_slice()).collect();
+    let mv: Vec<&[f64]> = vm.iter().map(|x| x.as_slice()).collect();
+    let start = t0_s + first as f64 * dt_s;
+    let wf = windows(
+        start,
+        dt_s,
+        &inside_with_confidence(&fv, &fb, &limits, confidence),
+        duration_s,
+    );
+    let wm = windows(start, dt_s, &inside(&mv, &limits), duration_s);
     Some(score_windows(&wf, &wm, duration_s))
 }
 
@@ -586,20 +609,39 @@ mod tests {
                     .collect()
             })
             .collect();
+        fn at<'a>(values: &'a [&'a [f64]], sigma: &'a [&'a [f64]], t0_s: f64, from: f64, to: f64) -> SpanForecast<'a> {
+            SpanForecast {
+                t0_s,
+                dt_s: 1.0,
+                values,
+                sigma,
+                trusted_from_s: from,
+                trusted_s: to,
+            }
+        }
         let f: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
-        let s = score_forecast_windows(&ch, &ext, 0.0, 1.0, &f, &measured, 120.0, 30.0).unwrap();
+        let s = score_forecast_windows(&ch, &ext, &at(&f, &[], 0.0, 0.0, 120.0), &measured, 30.0, 0.9).unwrap();
         assert_eq!((s.hits, s.misses, s.false_alarms, s.good_calls), (2, 0, 0, 2));
         assert_eq!(s.timing_errors_s, vec![0.0, 0.0]);
-        let calm: Vec<Vec<f64>> = (0..6).map(|_| vec![0.0; n]).collect();
-        let f: Vec<&[f64]> = calm.iter().map(|s| s.as_slice()).collect();
-        let s = score_forecast_windows(&ch, &ext, 0.0, 1.0, &f, &measured, 120.0, 30.0).unwrap();
+        let calm_owned: Vec<Vec<f64>> = (0..6).map(|_| vec![0.0; n]).collect();
+        let calm: Vec<&[f64]> = calm_owned.iter().map(|s| s.as_slice()).collect();
+        let s = score_forecast_windows(&ch, &ext, &at(&calm, &[], 0.0, 0.0, 120.0), &measured, 30.0, 0.9).unwrap();
         // one long forecast window over the whole span: it overlaps both real ones, and it held for
         // its first 30 s (the burst comes at 40 s)
         assert_eq!((s.hits, s.misses, s.false_alarms, s.good_calls), (2, 0, 0, 1));
         // starting at 20 s the same calm call fails: the burst is inside its first 30 s
-        let s = score_forecast_windows(&ch, &ext, 20.0, 1.0, &f, &measured, 100.0, 30.0).unwrap();
+        let s = score_forecast_windows(&ch, &ext, &at(&calm, &[], 20.0, 0.0, 100.0), &measured, 30.0, 0.9).unwrap();
         assert_eq!((s.false_alarms, s.good_calls), (1, 0));
+        // the calm call with a band of 0.7 m on heave: 0 +- 0.7 is likelier than 10 % to leave 1 m, so
+        // no quiet window is forecast: both real ones are missed, and no false alarm
+        let wide_owned: Vec<Vec<f64>> = (0..6).map(|s| vec![if s == 2 { 0.7 } else { 0.0 }; n]).collect();
+        let wide: Vec<&[f64]> = wide_owned.iter().map(|s| s.as_slice()).collect();
+        let s = score_forecast_windows(&ch, &ext, &at(&calm, &wide, 0.0, 0.0, 120.0), &measured, 30.0, 0.9).unwrap();
+        assert_eq!((s.hits, s.misses, s.false_alarms), (0, 2, 0));
+        // a span from 70 s: only the real window after the burst is scored, from its start
+        let s = score_forecast_windows(&ch, &ext, &at(&f, &[], 0.0, 70.0, 120.0), &measured, 30.0, 0.9).unwrap();
+        assert_eq!((s.hits, s.misses, s.timing_errors_s.clone()), (1, 0, vec![0.0]));
         // no measurement beyond 130 s: a forecast reaching past it is not scored
-        assert!(score_forecast_windows(&ch, &ext, 20.0, 1.0, &f, &measured, 120.0, 30.0).is_none());
+        assert!(score_forecast_windows(&ch, &ext, &at(&calm, &[], 20.0, 0.0, 120.0), &measured, 30.0, 0.9).is_none());
     }
 }

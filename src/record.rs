@@ -51,7 +51,8 @@ use std::path::Path;
 
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
 /// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
-/// `/radar`; 3: `/navigation`, `/elevation`.
+/// `/radar`; 3: `/navigation`, `/elevation`; 4: a forecast's `sigma` and `trusted_from_s`, a wave
+/// field's `window_s`.
 pub const LOG_SCHEMA_VERSION: u32 = 4;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).

@@ -84,7 +84,8 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                             flags: flags::names(h.flags),
                             compute_ms: h.compute_ms,
                             x: v.chunks_exact(n).take(6 * nv).map(|s| s.to_vec()).collect(),
-                            sigma: v[6 * nv * n..]
+                            // the band after all the daemon's series (it may have more vessels)
+                            sigma: v[h.n_series as usize * n..]
                                 .chunks_exact(n)
                                 .take(6 * nv)
                                 .map(|s| s.to_vec())

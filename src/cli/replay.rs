@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::hydro::VesselSystem;
 use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
-use shipcast::operation::{Channel, WindowScore, score_forecast_windows};
+use shipcast::operation::{Channel, SpanForecast, WindowScore, score_forecast_windows};
 use shipcast::record::{self, ForecastRecord, Record};
 use shipcast::replay;
 use shipcast::service::config::ShipcastConfig;
@@ -219,7 +219,7 @@ fn reports(
         dir,
         sys,
         &channels,
-        cfg.operation.duration_s,
+        (cfg.operation.duration_s, cfg.operation.confidence),
         forecasts,
         &measured,
         reference,
@@ -356,7 +356,7 @@ fn windows_report(
     dir: &Path,
     sys: &shipcast::hydro::VesselSystem,
     channels: &[Channel],
-    duration_s: f64,
+    (duration_s, confidence): (f64, f64),
     forecasts: &[ForecastRecord],
     measured: &[Vec<(f64, f64)>],
     reference: &str,
@@ -367,17 +367,19 @@ fn windows_report(
     for f in forecasts {
         let n = f.steps as usize + 1;
         let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
-        let trusted = shipcast::operation::trusted_horizon_s(channels, ext, &f.horizon_s);
-        let s = score_forecast_windows(
-            channels,
-            ext,
-            f.issue_time_s,
-            f.dt_s,
-            &series,
-            measured,
-            trusted,
-            duration_s,
-        );
+        let sigma: Vec<&[f64]> = f.sigma.chunks_exact(n).collect();
+        let span = SpanForecast {
+            t0_s: f.issue_time_s,
+            dt_s: f.dt_s,
+            values: &series,
+            sigma: &sigma,
+            trusted_from_s: channels
+                .iter()
+                .map(|c| c.trusted_from_s(ext, &f.trusted_from_s))
+                .fold(0.0, f64::max),
+            trusted_s: shipcast::operation::trusted_horizon_s(channels, ext, &f.horizon_s),
+        };
+        let s = score_forecast_windows(channels, ext, &span, measured, duration_s, confidence);
         if let Some(s) = s {
             total.add(&s);
             scored += 1;
@@ -400,7 +402,8 @@ fn windows_report(
         "false_alarm_ratio": total.false_alarm_ratio(),
         "timing_error_mean_s": mean,
         "timing_error_mean_abs_s": mean_abs,
-        "definitions": "per forecast, over its trusted horizon: a window is every channel inside its limit for at least duration_s; a window that happened is detected when a forecast window overlaps it (timing error = forecast start - actual start); a forecast window is a false alarm when the motion left a limit within duration_s of its start",
+        "confidence": confidence,
+        "definitions": "per forecast, over its trusted span: a forecast window is every channel inside its limit with the confidence by the forecast's band (as the console judges it), a window that happened every channel inside its limit, each for at least duration_s; a window that happened is detected when a forecast window overlaps it (timing error = forecast start - actual start); a forecast window is a false alarm when the motion left a limit within duration_s of its start",
     });
     std::fs::write(dir.join("windows.json"), serde_json::to_string_pretty(&json)? + "\n")?;
     let pct = |x: Option<f64>| x.map_or("n/a".to_string(), |v| format!("{:.0} %", 100.0 * v));

@@ -108,12 +108,16 @@ pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
                 100.0 * c.settings.confidence
             ),
         ),
-        Verdict::Unknown if o.trusted_from_s > 0.0 => (
+        Verdict::Unknown if o.trusted_from_s > 0.0 && o.trusted_from_s < o.trusted_s => (
             Severity::Caution,
             format!(
                 "CAN'T TELL: the forecast is trusted from {:.0} s to {:.0} s ahead: not the next {:.0} s",
                 o.trusted_from_s, o.trusted_s, o.trusted_from_s
             ),
+        ),
+        Verdict::Unknown if o.trusted_from_s > 0.0 => (
+            Severity::Caution,
+            "CAN'T TELL: the channels' trusted spans do not overlap".into(),
         ),
         Verdict::Unknown => (
             Severity::Caution,

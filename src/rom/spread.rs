@@ -65,7 +65,8 @@ pub struct ResponseTable {
 }
 
 impl ResponseTable {
-    /// The table of a model's own response (`TimeModel::implied_rao`).
+    /// The table of a model's own response (`TimeModel::implied_rao`); a heading the database does not
+    /// cover has no response (the forecast leaves its waves out too).
     pub fn of(model: &TimeModel) -> Result<ResponseTable> {
         let ws = &model.db.exc_omega_rad_s;
         let (w0, w1) = (ws[0], ws[ws.len() - 1]);
@@ -78,7 +79,13 @@ impl ResponseTable {
             let k = model.kernel_at(w);
             for ib in 0..TABLE_HEADINGS {
                 let beta = TAU * ib as f64 / TABLE_HEADINGS as f64;
-                rao.extend(model.implied_rao_with(&k, w, beta)?);
+                match model.implied_rao_with(&k, w, beta) {
+                    Ok(r) => rao.extend(r),
+                    Err(crate::rom::Error::Hydro(crate::hydro::Error::OutOfRange(_))) => {
+                        rao.extend(std::iter::repeat_n(num_complex::Complex64::default(), n_modes))
+                    }
+                    Err(e) => return Err(e),
+                }
             }
         }
         let gain2 = rao.iter().map(|r| r.norm_sqr()).collect();

@@ -275,12 +275,25 @@ impl Computer {
             model_error: job.model_error.clone(),
             trusted_nrmse: self.trusted_nrmse,
         };
+        // a vessel the field cannot be trusted for (no region, stale navigation) knows none of it
+        let known: Vec<Vec<[f64; 2]>> = job
+            .known_leads
+            .iter()
+            .enumerate()
+            .map(|(b, k)| {
+                if job.trustworthy.get(b).copied().unwrap_or(false) {
+                    k.clone()
+                } else {
+                    vec![[0.0, 0.0]; k.len()]
+                }
+            })
+            .collect();
         let result = result.map(|(values, steps, dropped, quasi_static)| {
             let spread = self.table.as_ref().map(|table| {
                 spread::spread(
                     table,
                     &job.waves,
-                    &job.known_leads,
+                    &known,
                     n_bodies,
                     job.track.map_or(0.0, |t| t.speed_m_s),
                     model.g_m_s2,
@@ -311,7 +324,8 @@ impl Computer {
                         motion_sigma = s.motion_sigma;
                     }
                     None => {
-                        values.extend(std::iter::repeat_n(0.0, 6 * n_bodies * (steps + 1)));
+                        // no band known: not a band of zero
+                        values.extend(std::iter::repeat_n(f64::NAN, 6 * n_bodies * (steps + 1)));
                         header.horizon_s = [0.0; MAX_VESSELS];
                         header.trusted_from_s = [0.0; MAX_VESSELS];
                     }
@@ -1108,8 +1122,13 @@ impl Engine {
                 }
                 self.counters.forecasts += 1;
                 self.last_forecast_time = header.issue_time_s;
+                // only forecasts the daemon trusts teach it the model's error (an untrusted one's
+                // error is its waves')
                 let n = (header.steps as usize + 1) * header.n_series as usize;
-                if values.len() == 2 * n {
+                let trusted = header.horizon_s[..(header.n_vessels as usize).min(MAX_VESSELS)]
+                    .iter()
+                    .all(|h| *h > 0.0);
+                if values.len() == 2 * n && trusted {
                     self.model_error.record(
                         header.issue_time_s,
                         header.dt_s,
