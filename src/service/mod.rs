@@ -117,10 +117,10 @@ pub struct Job {
     known: usize,
     waves: Vec<crate::waves::WaveComponent>,
     /// Per vessel, per component of `waves`, the leads (s from t0) over which it is known
-    /// (`horizon::known_leads`).
+    /// (`horizon::known_leads`; none when the field cannot be trusted).
     known_leads: Vec<Vec<[f64; 2]>>,
-    /// Per vessel, whether the field can be trusted at all (located, navigation fresh).
-    trustworthy: Vec<bool>,
+    /// Whether the field can be trusted at all (located, navigation fresh).
+    trustworthy: bool,
     /// The model error of each series against lead, as a fraction of its motion
     /// ([`spread::ModelError`]).
     model_error: spread::ModelErrorCurve,
@@ -275,25 +275,12 @@ impl Computer {
             model_error: job.model_error.clone(),
             trusted_nrmse: self.trusted_nrmse,
         };
-        // a vessel the field cannot be trusted for (no region, stale navigation) knows none of it
-        let known: Vec<Vec<[f64; 2]>> = job
-            .known_leads
-            .iter()
-            .enumerate()
-            .map(|(b, k)| {
-                if job.trustworthy.get(b).copied().unwrap_or(false) {
-                    k.clone()
-                } else {
-                    vec![[0.0, 0.0]; k.len()]
-                }
-            })
-            .collect();
         let result = result.map(|(values, steps, dropped, quasi_static)| {
             let spread = self.table.as_ref().map(|table| {
                 spread::spread(
                     table,
                     &job.waves,
-                    &known,
+                    &job.known_leads,
                     n_bodies,
                     job.track.map_or(0.0, |t| t.speed_m_s),
                     model.g_m_s2,
@@ -317,7 +304,7 @@ impl Computer {
                     Some(s) => {
                         values.extend_from_slice(&s.sigma);
                         for b in 0..n_bodies.min(MAX_VESSELS) {
-                            let ok = job.trustworthy.get(b).copied().unwrap_or(false) && s.to_s[b] > 0.0;
+                            let ok = job.trustworthy && s.to_s[b] > 0.0;
                             header.horizon_s[b] = if ok { s.to_s[b] } else { 0.0 };
                             header.trusted_from_s[b] = if ok { s.from_s[b] } else { 0.0 };
                         }
@@ -1069,13 +1056,18 @@ impl Engine {
                     }
                     _ => true,
                 };
-                // each component's known leads at each vessel, from t0 (the field is that much older)
+                // each component's known leads at each vessel, from t0 (the field is that much older);
+                // a field that cannot be trusted (no region, stale navigation) tells none of them
+                let trustworthy = located && !untrusted;
                 let (s, c) = heading.sin_cos();
                 let age_s = (t0 - f.time_s).max(0.0);
                 let known_leads: Vec<Vec<[f64; 2]>> = self
                     .body_xy_m
                     .iter()
                     .map(|r| {
+                        if !trustworthy {
+                            return vec![[0.0, 0.0]; f.components.len()];
+                        }
                         let p = [origin[0] + c * r[0] - s * r[1], origin[1] + s * r[0] + c * r[1]];
                         horizon::known_leads(f, p, velocity)
                             .into_iter()
@@ -1083,7 +1075,6 @@ impl Engine {
                             .collect()
                     })
                     .collect();
-                let trustworthy = vec![located && !untrusted; n_bodies];
                 fl = header.flags;
                 self.busy = true;
                 job = Some(Job {

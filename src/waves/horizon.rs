@@ -35,23 +35,6 @@ pub struct Horizon {
     pub noncausal_s: f64,
 }
 
-/// Lead time at which a group leaves the observed disc: the largest t with
-/// |offset + (u - c_g d) t| <= R (0 if the vessel starts outside and the group never enters).
-fn disc_exit(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> f64 {
-    // |o + r t|^2 = R^2: (r.r) t^2 + 2 (o.r) t + (o.o - R^2) = 0
-    let a = rel[0] * rel[0] + rel[1] * rel[1];
-    let b = offset[0] * rel[0] + offset[1] * rel[1];
-    let c = offset[0] * offset[0] + offset[1] * offset[1] - radius * radius;
-    if a <= 0.0 {
-        return if c <= 0.0 { f64::INFINITY } else { 0.0 };
-    }
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return 0.0;
-    }
-    ((-b + disc.sqrt()) / a).max(0.0)
-}
-
 /// Steps of [`coverage_exit`]'s march, m (longer on a region so large that it would take more than
 /// [`COVERAGE_STEPS`]).
 const COVERAGE_STEP_M: f64 = 10.0;
@@ -120,11 +103,12 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
             let rel = [velocity_m_s[0] - cg * d[0], velocity_m_s[1] - cg * d[1]];
             let t = match field.region {
                 Region::Everywhere => f64::INFINITY,
-                Region::Disc { centre_m, radius_m } => disc_exit(
+                // the exit of the disc: the end of the span its water is inside it
+                Region::Disc { centre_m, radius_m } => disc_span(
                     [position_m[0] - centre_m[0], position_m[1] - centre_m[1]],
                     radius_m,
                     rel,
-                ),
+                )[1],
                 Region::Coverage { .. } => coverage_exit(&field.region, position_m, rel),
                 Region::Point { at_m, .. } => {
                     // a probe: the group reaches the (stationary) vessel after travelling from it
@@ -279,7 +263,7 @@ pub fn of_sea(
         for (d, wd) in &dirs {
             let dir = sea.heading_rad + d;
             let rel = [speed_m_s - cg * dir.cos(), -cg * dir.sin()];
-            parts.push((s * wd, disc_exit([0.0, 0.0], radius_m, rel), w, dir, cg));
+            parts.push((s * wd, disc_span([0.0, 0.0], radius_m, rel)[1], w, dir, cg));
         }
     }
     quantile(parts, noncausal_s)
@@ -290,13 +274,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn disc_exit_cases() {
+    fn disc_exit_is_the_end_of_the_disc_span() {
         // from the centre, moving at 5 m/s: R / 5
-        assert!((disc_exit([0.0, 0.0], 1000.0, [5.0, 0.0]) - 200.0).abs() < 1e-9);
+        assert!((disc_span([0.0, 0.0], 1000.0, [5.0, 0.0])[1] - 200.0).abs() < 1e-9);
         // starting 600 m upstream (groups coming towards it from beyond the far edge)
-        assert!((disc_exit([600.0, 0.0], 1000.0, [5.0, 0.0]) - 80.0).abs() < 1e-9);
+        assert!((disc_span([600.0, 0.0], 1000.0, [5.0, 0.0])[1] - 80.0).abs() < 1e-9);
         // outside and moving away: never inside
-        assert_eq!(disc_exit([2000.0, 0.0], 1000.0, [5.0, 0.0]), 0.0);
+        assert_eq!(disc_span([2000.0, 0.0], 1000.0, [5.0, 0.0])[1], 0.0);
     }
 
     #[test]
