@@ -43,6 +43,9 @@ pub struct RadarSpec {
     pub blind_radius_m: f64,
     /// A sector the superstructure masks: relative bearings from, to (deg clockwise from the bow).
     pub masked_sector_deg: Option<(f64, f64)>,
+    /// The antenna's height above the mean water level, m: a cell is shadowed (no echo) where a crest
+    /// nearer the antenna rises above the line of sight to it (0: no shadowing).
+    pub antenna_height_m: f64,
 }
 
 /// The motion sensors.
@@ -56,6 +59,11 @@ pub struct ImuSpec {
     /// Constant bias added to every translation (m) and rotation (rad).
     pub bias_m: f64,
     pub bias_rad: f64,
+    /// Drift: a bias that wanders (first-order Gauss-Markov, per DOF) with this standard deviation of
+    /// translations (m) and rotations (rad), and this correlation time (s).
+    pub drift_m: f64,
+    pub drift_rad: f64,
+    pub drift_time_s: f64,
 }
 
 /// The navigation sensors (a GNSS and a gyro compass).
@@ -87,6 +95,8 @@ pub struct SimSpec {
     pub navigation: NavSpec,
     /// Model error: the true vessels' linear damping is this factor times the model's.
     pub damping_factor: f64,
+    /// The radar sees the sea's second-order bound waves as well (the vessels feel the linear sea).
+    pub bound_waves: bool,
     pub seed: u64,
 }
 
@@ -140,13 +150,34 @@ pub struct Simulation {
     body_xy_m: Vec<[f64; 2]>,
     /// The radar map's centre, earth frame, m.
     map_centre_m: Option<[f64; 2]>,
+    /// The sea's mean wavenumber (at its mean frequency), rad/m: the bound waves' narrow-band scale.
+    mean_wavenumber_rad_m: f64,
+    /// Each vessel's IMU drift now (6 DOF), and when it was last drawn.
+    drift: Vec<[f64; 6]>,
+    drift_time_s: Option<f64>,
 }
 
 impl Simulation {
-    /// Realizes the sea and computes the true motion (the system's own model, damping scaled).
-    pub fn new(sys: &VesselSystem, opts: RomOptions, spec: SimSpec) -> rom::Result<Simulation> {
+    /// Realizes the sea and computes the true motion: `truth`'s model of the same bodies if given (another
+    /// database, other damping), else the forecaster's own `sys`; linear damping scaled by
+    /// `spec.damping_factor`.
+    pub fn new(
+        sys: &VesselSystem,
+        truth: Option<&VesselSystem>,
+        opts: RomOptions,
+        spec: SimSpec,
+    ) -> rom::Result<Simulation> {
+        let truth = truth.unwrap_or(sys);
+        let names = |s: &VesselSystem| s.spec.bodies.iter().map(|b| b.name.clone()).collect::<Vec<_>>();
+        if names(truth) != names(sys) {
+            return Err(rom::Error::Input(format!(
+                "the truth's bodies {:?} are not the model's {:?}",
+                names(truth),
+                names(sys)
+            )));
+        }
         // the database at the track's speed, as the daemon's model takes it
-        let mut truth_sys = sys.at_speed(spec.track.speed_m_s)?;
+        let mut truth_sys = truth.at_speed(spec.track.speed_m_s)?;
         for b in truth_sys.spec.bodies.iter_mut() {
             b.linear_damping *= spec.damping_factor;
         }
@@ -158,17 +189,23 @@ impl Simulation {
                 ..opts
             },
         )?;
-        let sea = WaveField::from_components(
-            &realize_all(&spec.seas),
-            sys.spec.g_m_s2,
-            sys.spec.water_depth_m,
-            Region::Everywhere,
-        );
+        let components = realize_all(&spec.seas);
+        let sea = WaveField::from_components(&components, sys.spec.g_m_s2, sys.spec.water_depth_m, Region::Everywhere);
         let waves = sea.for_vessel(spec.origin_m, spec.heading_rad, 0.0);
         let truth = Forecaster::new()
             .from_rest_on(&model, &waves, spec.duration_s, spec.ramp_s, Some(spec.track))?
             .clone();
+        let energy: f64 = sea.components.iter().map(|c| c.amplitude_m.norm_sqr()).sum();
+        let mean_omega = sea
+            .components
+            .iter()
+            .map(|c| c.amplitude_m.norm_sqr() * c.omega_rad_s)
+            .sum::<f64>()
+            / energy.max(f64::MIN_POSITIVE);
         Ok(Simulation {
+            mean_wavenumber_rad_m: if energy > 0.0 { sea.wave_number(mean_omega) } else { 0.0 },
+            drift: vec![[0.0; 6]; sys.spec.bodies.len()],
+            drift_time_s: None,
             n_bodies: sys.spec.bodies.len(),
             body_xy_m: sys.spec.reference_points_xy_m(),
             map_centre_m: None,
@@ -192,6 +229,7 @@ impl Simulation {
     /// The IMU samples of every vessel at time t.
     pub fn imu(&mut self, t_s: f64) -> Vec<ImuSample> {
         let s = self.spec.imu;
+        self.advance_drift(t_s);
         (0..self.n_bodies)
             .map(|b| {
                 let mut x = [0.0; 6];
@@ -202,7 +240,7 @@ impl Simulation {
                     } else {
                         (s.noise_rad, s.bias_rad)
                     };
-                    x[d] = self.true_x(t_s, 6 * b + d) + bias + noise * gauss(&mut self.rng);
+                    x[d] = self.true_x(t_s, 6 * b + d) + bias + self.drift[b][d] + noise * gauss(&mut self.rng);
                     v[d] = self.true_v(t_s, 6 * b + d) + 0.1 * noise * s.rate_hz * gauss(&mut self.rng);
                 }
                 ImuSample {
@@ -213,6 +251,25 @@ impl Simulation {
                 }
             })
             .collect()
+    }
+
+    /// Moves every IMU's drift on to `t_s` (first-order Gauss-Markov: exact in any step; drawn from its
+    /// stationary distribution at the first sample).
+    fn advance_drift(&mut self, t_s: f64) {
+        let s = self.spec.imu;
+        let keep = match self.drift_time_s {
+            Some(t0) if s.drift_time_s > 0.0 => (-(t_s - t0).max(0.0) / s.drift_time_s).exp(),
+            Some(_) => 1.0,
+            None => 0.0,
+        };
+        let fresh = (1.0 - keep * keep).max(0.0).sqrt();
+        for b in 0..self.n_bodies {
+            for d in 0..6 {
+                let sigma = if d < 3 { s.drift_m } else { s.drift_rad };
+                self.drift[b][d] = keep * self.drift[b][d] + fresh * sigma * gauss(&mut self.rng);
+            }
+        }
+        self.drift_time_s = Some(t_s);
     }
 
     /// The seakeeping frame's earth heading (rad, counterclockwise from east) and origin (m) at `t_s`.
@@ -295,11 +352,30 @@ impl Simulation {
             }
         }
         let mut values = vec![0.0; pts.len()];
-        self.sea.elevation(&pts, t_s, &mut values);
+        if r.antenna_height_m > 0.0 || self.spec.bound_waves {
+            let mut analytic = vec![num_complex::Complex64::default(); pts.len()];
+            self.sea.analytic_elevation(&pts, t_s, &mut analytic);
+            let k = if self.spec.bound_waves {
+                self.mean_wavenumber_rad_m
+            } else {
+                0.0
+            };
+            for (v, a) in values.iter_mut().zip(&analytic) {
+                *v = bound_elevation(*a, k);
+            }
+        } else {
+            self.sea.elevation(&pts, t_s, &mut values);
+        }
         // cells the radar does not see are NaN: beyond its range, in its blind zone, in the sector
-        // the superstructure masks (relative bearings clockwise from the bow, seen from the ship)
+        // the superstructure masks (relative bearings clockwise from the bow, seen from the ship),
+        // shadowed behind a crest nearer the antenna
         let (heading, ship) = self.pose(t_s);
-        for (p, v) in pts.iter().zip(values.iter_mut()) {
+        let shadowed = if r.antenna_height_m > 0.0 {
+            shadow(&xs, &ys, &values, ship, r.antenna_height_m)
+        } else {
+            vec![false; values.len()]
+        };
+        for ((p, v), hidden) in pts.iter().zip(values.iter_mut()).zip(shadowed) {
             let range = (p[0] - o[0]).hypot(p[1] - o[1]);
             let masked = r.masked_sector_deg.is_some_and(|(from, to)| {
                 let (dx, dy) = (p[0] - ship[0], p[1] - ship[1]);
@@ -312,7 +388,7 @@ impl Simulation {
                 }
             });
             let from_antenna = (p[0] - ship[0]).hypot(p[1] - ship[1]);
-            if range > r.radius_m || from_antenna < r.blind_radius_m || masked {
+            if range > r.radius_m || from_antenna < r.blind_radius_m || masked || hidden {
                 *v = f64::NAN;
             } else {
                 *v += r.noise_m * gauss(&mut self.rng);
@@ -366,6 +442,61 @@ impl Simulation {
     }
 }
 
+/// The elevation with the sea's second-order bound waves, from the linear sea's analytic signal
+/// `a` (real part the elevation, imaginary part its Hilbert transform) and its mean wavenumber `k`:
+/// Tayfun's narrow-band model (J. Geophys. Res. 85(C3), 1980), `eta + k/2 (eta^2 - eta_H^2)`, deep
+/// water: one component of amplitude A gains Stokes' second harmonic, k A^2 / 2 cos 2 theta.
+pub fn bound_elevation(a: num_complex::Complex64, k_rad_m: f64) -> f64 {
+    a.re + 0.5 * k_rad_m * (a.re * a.re - a.im * a.im)
+}
+
+/// Which cells of a grid (`values[iy * xs.len() + ix]`, elevations, m) an antenna at `antenna_m`,
+/// `height_m` above the mean level, cannot see: a crest between them rises above the line of sight
+/// (geometric shadowing). The line is followed in half-cell steps through the bilinear surface; cells
+/// within one cell of the antenna are seen.
+pub fn shadow(xs: &[f64], ys: &[f64], values: &[f64], antenna_m: [f64; 2], height_m: f64) -> Vec<bool> {
+    let (nx, ny) = (xs.len(), ys.len());
+    if nx < 2 || ny < 2 || values.len() != nx * ny {
+        return vec![false; values.len()];
+    }
+    let (dx, dy) = (
+        (xs[nx - 1] - xs[0]) / (nx - 1) as f64,
+        (ys[ny - 1] - ys[0]) / (ny - 1) as f64,
+    );
+    let cell = dx.min(dy);
+    let at = |x: f64, y: f64| -> Option<f64> {
+        let (u, v) = ((x - xs[0]) / dx, (y - ys[0]) / dy);
+        if !(u >= 0.0 && v >= 0.0 && u <= (nx - 1) as f64 && v <= (ny - 1) as f64) {
+            return None;
+        }
+        let (i, j) = ((u as usize).min(nx - 2), (v as usize).min(ny - 2));
+        let (fu, fv) = (u - i as f64, v - j as f64);
+        let z = |i: usize, j: usize| values[j * nx + i];
+        let e = (1.0 - fv) * ((1.0 - fu) * z(i, j) + fu * z(i + 1, j))
+            + fv * ((1.0 - fu) * z(i, j + 1) + fu * z(i + 1, j + 1));
+        e.is_finite().then_some(e)
+    };
+    let mut out = vec![false; values.len()];
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let v = values[iy * nx + ix];
+            let (ex, ey) = (xs[ix] - antenna_m[0], ys[iy] - antenna_m[1]);
+            let range = ex.hypot(ey);
+            if !v.is_finite() || range <= cell {
+                continue;
+            }
+            // the slope of the line of sight to this cell, and of every point before it
+            let slope = (v - height_m) / range;
+            let steps = (2.0 * range / cell).floor() as usize;
+            out[iy * nx + ix] = (2..steps).any(|s| {
+                let f = 0.5 * s as f64 * cell / range;
+                at(antenna_m[0] + f * ex, antenna_m[1] + f * ey).is_some_and(|e| (e - height_m) / (f * range) > slope)
+            });
+        }
+    }
+    out
+}
+
 /// A grid with its NaN cells (not seen) set to zero.
 pub fn zero_invalid(g: &Grid) -> Grid {
     Grid {
@@ -390,4 +521,54 @@ fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let u1: f64 = rng.random::<f64>().max(1e-300);
     let u2: f64 = rng.random();
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_complex::Complex64;
+
+    /// One component of amplitude A: the bound wave is Stokes' second harmonic, k A^2 / 2 cos 2 theta.
+    #[test]
+    fn bound_waves_of_one_component_are_stokes_second_order() {
+        let (amp_m, k_rad_m) = (1.5, 0.05);
+        for theta in [0.0, 0.4, 1.3, 2.9, 4.0] {
+            let a = Complex64::from_polar(amp_m, theta);
+            let stokes = amp_m * f64::cos(theta) + 0.5 * k_rad_m * amp_m * amp_m * f64::cos(2.0 * theta);
+            assert!((bound_elevation(a, k_rad_m) - stokes).abs() < 1e-12, "theta {theta}");
+        }
+        // crests sharpen, troughs flatten
+        assert!(bound_elevation(Complex64::new(1.0, 0.0), k_rad_m) > 1.0);
+        assert!(bound_elevation(Complex64::new(-1.0, 0.0), k_rad_m) > -1.0);
+    }
+
+    fn grid(n: usize, d_m: f64) -> (Vec<f64>, Vec<f64>) {
+        let c: Vec<f64> = (0..n).map(|i| (i as f64 - (n - 1) as f64 / 2.0) * d_m).collect();
+        (c.clone(), c)
+    }
+
+    #[test]
+    fn a_flat_sea_shadows_nothing_and_a_ridge_hides_what_is_behind_it() {
+        let (xs, ys) = grid(41, 10.0);
+        let flat = vec![0.0; xs.len() * ys.len()];
+        assert!(shadow(&xs, &ys, &flat, [0.0, 0.0], 20.0).iter().all(|s| !s));
+        // a 3 m ridge along x = 100 m: from 20 m up, the water just beyond it (down to 20 m x / 100 m - 20
+        // ... ) is hidden; the ridge itself and the water before it are seen
+        let ridge: Vec<f64> = (0..ys.len())
+            .flat_map(|_| xs.iter().map(|x| if (*x - 100.0).abs() < 1.0 { 3.0 } else { 0.0 }))
+            .collect();
+        let hidden = shadow(&xs, &ys, &ridge, [0.0, 0.0], 20.0);
+        let at = |x: f64, y: f64| {
+            let ix = xs.iter().position(|v| (*v - x).abs() < 1e-9).unwrap();
+            let iy = ys.iter().position(|v| (*v - y).abs() < 1e-9).unwrap();
+            hidden[iy * xs.len() + ix]
+        };
+        assert!(!at(50.0, 0.0) && !at(100.0, 0.0), "before and on the ridge");
+        assert!(at(110.0, 0.0) && at(110.0, 20.0), "just behind the ridge");
+        // the line of sight over a 3 m ridge 100 m off from 20 m up meets the water 117.6 m off
+        assert!(!at(130.0, 0.0), "far enough behind it");
+        assert!(!at(-110.0, 0.0), "on the other side");
+        // no shadowing from a mast higher than any crest close in
+        assert!(shadow(&xs, &ys, &ridge, [0.0, 0.0], 1e6).iter().all(|s| !s));
+    }
 }

@@ -1,7 +1,7 @@
 //! Recorded logs and replay (issue 7): a simulated log read by an off-the-shelf reader in Python,
 //! replayed through the daemon's engine deterministically, skill against lead time, damaged logs.
 
-use crate::util::{repo, scratch_dir, shipcast, simulate_to};
+use crate::util::{absolute_truth, repo, scratch_dir, shipcast, simulate_to};
 use std::path::{Path, PathBuf};
 
 /// The simulated logs' data clock at the start (2025-06-15 UTC): fixed, so logs are reproducible.
@@ -10,8 +10,7 @@ const START_UNIX_S: f64 = 1_750_000_000.0;
 /// The README's skill-report config (`config/one-ship.toml`), copied into `dir` with its system path
 /// made absolute and the data clock's start fixed.
 fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(repo("config/one-ship.toml"))
-        .unwrap()
+    let text = absolute_truth(&std::fs::read_to_string(repo("config/one-ship.toml")).unwrap())
         .replace(
             "file = \"vessels/ship/system.toml\"",
             &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
@@ -146,7 +145,8 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
         let i = lead.iter().position(|x| *x == l).unwrap();
         a["vessels"]["carrier"][dof]["correlation"][i].as_f64().unwrap()
     };
-    // the horizon of a 1 km disc for Tp 9 s: about 1000 / 11.6 = 86 s (shipcast horizon)
+    // the truth is another model of the hull and the radar a real one's (blind zone, shadowing, bound
+    // waves): skill as at sea, not a twin's
     eprintln!(
         "heave correlation at 30 / 60 / 110 s: {:.3} / {:.3} / {:.3}; pitch {:.3} / {:.3} / {:.3}",
         corr("heave", 30.0),
@@ -156,17 +156,44 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
         corr("pitch", 60.0),
         corr("pitch", 110.0)
     );
-    assert!(corr("heave", 30.0) > 0.9 && corr("pitch", 30.0) > 0.9);
-    assert!(corr("heave", 110.0) < corr("heave", 30.0) - 0.2);
-    // the band: the truth inside the published 90 % band about nine times in ten up to the trusted
-    // horizon, for the motions of this head sea (its roll is a few hundredths of a degree of noise)
-    let horizon = a["trusted_horizon_s"]["carrier"].as_f64().unwrap();
-    assert!((60.0..=120.0).contains(&horizon), "{horizon}");
-    assert_eq!(a["trusted_from_s"]["carrier"].as_f64(), Some(0.0));
     for dof in ["heave", "pitch"] {
-        for (i, l) in lead.iter().enumerate().filter(|(_, l)| **l > 0.0 && **l <= horizon) {
+        assert!(
+            corr(dof, 60.0) > MIN_SEA_CORRELATION,
+            "{dof} at 60 s: {}",
+            corr(dof, 60.0)
+        );
+        assert!(
+            corr(dof, 30.0) < MAX_SEA_CORRELATION,
+            "{dof} at 30 s: {}: a twin's",
+            corr(dof, 30.0)
+        );
+        assert!(
+            corr(dof, 120.0) < corr(dof, 60.0) - 0.2,
+            "{dof}: skill falls past the radar's reach"
+        );
+    }
+    // the band: the truth inside the published 90 % band about nine times in ten at every lead, for
+    // the motions of this head sea (its roll is a few hundredths of a degree); the span, where one is
+    // published, only where the forecast's error is what it says
+    for dof in ["heave", "pitch"] {
+        for (i, l) in lead.iter().enumerate().filter(|(_, l)| **l > 0.0) {
             let c = a["vessels"]["carrier"][dof]["coverage_90"][i].as_f64().unwrap();
             assert!(SHORT_LOG_COVERAGE.contains(&c), "{dof} at {l} s: coverage_90 {c}");
+        }
+    }
+    let (from, to) = (
+        a["trusted_from_s"]["carrier"].as_f64().unwrap(),
+        a["trusted_horizon_s"]["carrier"].as_f64().unwrap(),
+    );
+    eprintln!("median trusted span {from:.0}-{to:.0} s");
+    for dof in ["heave", "pitch"] {
+        for (i, l) in lead
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| **l >= from && **l <= to && to > 0.0)
+        {
+            let e = a["vessels"]["carrier"][dof]["nrmse"][i].as_f64().unwrap();
+            assert!(e <= SHORT_LOG_SPAN_NRMSE, "{dof} at {l} s, inside the span: NRMSE {e}");
         }
     }
 }
@@ -174,6 +201,15 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
 /// The 90 % band's coverage allowed on a 10-minute log: its first minutes use the configured prior
 /// while the model error is learnt (README, "How far a forecast is trusted": the 30-minute figures).
 const SHORT_LOG_COVERAGE: std::ops::RangeInclusive<f64> = 0.7..=1.0;
+/// Inside the median published span, the error a 10-minute log allows: `forecast.trusted_nrmse` (0.6)
+/// and the first minutes' forecasts, made with the prior.
+const SHORT_LOG_SPAN_NRMSE: f64 = 0.75;
+/// Heave and pitch correlation at 60 s lead in the realistic sea, at least: sea trials of radar-based
+/// forecasts report 0.8-0.9 (Naaijen et al., OMAE 2016); measured 0.82 / 0.95 on this log.
+const MIN_SEA_CORRELATION: f64 = 0.7;
+/// ... and at 30 s at most: the twin experiment (the truth the forecaster's own model, a perfect radar
+/// disc) gave 0.98 / 1.00, which no radar at sea does.
+const MAX_SEA_CORRELATION: f64 = 0.97;
 
 #[test]
 fn python_lists_the_channels_and_decodes_a_message_of_each() {

@@ -20,6 +20,7 @@ mod indep_barge_probe;
 mod kramers_kronig;
 mod replay;
 mod rom;
+mod sim_truth;
 mod trust;
 mod two_ship_demo;
 mod underway;

@@ -6,7 +6,7 @@
 //! noise integrated over the forecast by the modes without restoring), and the free pair's forecasts
 //! closed the 5 m gap by 22 m.
 
-use crate::util::{SimLog, simulated};
+use crate::util::{SimLog, TWIN_SEA, simulated_with};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::ForecastHeader;
 use shipcast::replay::{self, Record};
@@ -49,7 +49,17 @@ impl Forecast {
 /// The demo's log: its config's system must be the moored pair.
 fn log() -> &'static SimLog {
     static LOG: OnceLock<SimLog> = OnceLock::new();
-    LOG.get_or_init(|| simulated("two-ship-demo", "shipcast.toml", "vessels/pair/moored.toml", LOG_S))
+    // the drift estimate under test, in the twin sea: with the shipped radar (shadowing, blind zone)
+    // consecutive forecasts of the lighter's surge at 119 s differ by up to 2.4 m (issue 28's notes)
+    LOG.get_or_init(|| {
+        simulated_with(
+            "two-ship-demo",
+            "shipcast.toml",
+            "vessels/pair/moored.toml",
+            LOG_S,
+            &TWIN_SEA,
+        )
+    })
 }
 
 fn forecasts(drift_window_s: f64) -> Vec<Forecast> {

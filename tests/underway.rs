@@ -6,7 +6,7 @@
 //! counterclockwise; a track's rate of turn counterclockwise (to port) positive; the simulator's
 //! `[simulate.track] turn_deg_s` is a compass rate (to starboard positive).
 
-use crate::util::{SimLog, simulated_with};
+use crate::util::{SimLog, TWIN_SEA, simulated_with};
 use num_complex::Complex64;
 use shipcast::files::load_system;
 use shipcast::ipc::Output;
@@ -315,11 +315,16 @@ fn demo_log() -> &'static SimLog {
             "shipcast.toml",
             "vessels/pair/moored.toml",
             DEMO_S,
+            // the navigation pipeline under test: the twin sea, so that a slip of pose shows
             &[
-                ("speed_m_s = 0.0 ", "speed_m_s = 3.0 "),
-                ("turn_deg_s = 0.0 ", "turn_deg_s = 0.2 "),
-                ("turn_start_s = 0.0 ", "turn_start_s = 300.0 "),
-            ],
+                &TWIN_SEA[..],
+                &[
+                    ("speed_m_s = 0.0 ", "speed_m_s = 3.0 "),
+                    ("turn_deg_s = 0.0 ", "turn_deg_s = 0.2 "),
+                    ("turn_start_s = 0.0 ", "turn_start_s = 300.0 "),
+                ],
+            ]
+            .concat(),
         )
     })
 }

@@ -33,10 +33,10 @@ pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: 
     }
     let file = format!("file = \"{system}\"");
     assert!(text.contains(&file), "config/{config} does not say {file}");
-    let text = text.replace(
+    let text = absolute_truth(&text.replace(
         &file,
         &format!("file = \"{}\"", repo(&format!("config/{system}")).display()),
-    );
+    ));
     let cfg_path = dir.join("shipcast.toml");
     std::fs::write(&cfg_path, text).unwrap();
     let path = dir.join("sim.mcap");
@@ -48,6 +48,32 @@ pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: 
             .system,
         records: shipcast::replay::read(&path).unwrap().records,
     }
+}
+
+/// Edits of `config/shipcast.toml` (for [`simulated_with`]) that make its synthetic sea a twin
+/// experiment: the truth the forecaster's own model (damping 1.2 x), a radar disc seen whole without
+/// shadowing or bound waves, IMUs that do not drift. For tests of a pipeline (a slip of time, frame
+/// or pose shows in the correlation), not of skill: the shipped sensors are the README's matrix's.
+pub const TWIN_SEA: [(&str, &str); 7] = [
+    ("truth_system = \"vessels/", "# truth_system = \"vessels/"),
+    ("bound_waves = true ", "bound_waves = false "),
+    ("blind_radius_m = 200.0 ", "blind_radius_m = 0.0 "),
+    (
+        "masked_sector_deg = [160.0, 200.0]",
+        "# masked_sector_deg = [160.0, 200.0]",
+    ),
+    ("antenna_height_m = 30.0 ", "antenna_height_m = 0.0 "),
+    ("drift_m = 0.02 ", "drift_m = 0.0 "),
+    ("drift_rad = 0.0003 ", "drift_rad = 0.0 "),
+];
+
+/// A shipped config's text with its `[simulate] truth_system` (relative to `config/`) made absolute,
+/// for a copy elsewhere.
+pub fn absolute_truth(text: &str) -> String {
+    text.replace(
+        "truth_system = \"vessels/",
+        &format!("truth_system = \"{}/", repo("config/vessels").display()),
+    )
 }
 
 /// `shipcast simulate --config CFG --record LOG --duration SECS`, which must succeed.

@@ -117,6 +117,7 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
             omega_max_rad_s: 1.1 * s.sea.omega_max_rad_s,
             blind_radius_m: s.radar.blind_radius_m,
             masked_sector_deg: s.radar.masked_sector_deg.map(|m| (m[0], m[1])),
+            antenna_height_m: s.radar.antenna_height_m,
         },
         imu: ImuSpec {
             rate_hz: s.imu.rate_hz,
@@ -124,6 +125,9 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
             noise_rad: s.imu.noise_rad,
             bias_m: s.imu.bias_m,
             bias_rad: s.imu.bias_rad,
+            drift_m: s.imu.drift_m,
+            drift_rad: s.imu.drift_rad,
+            drift_time_s: s.imu.drift_time_s,
         },
         duration_s,
         ramp_s: s.ramp_s,
@@ -142,6 +146,7 @@ fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
             position_noise_m: s.navigation.position_noise_m,
         },
         damping_factor: s.damping_factor,
+        bound_waves: s.sea.bound_waves,
         seed: s.seed,
     }
 }
@@ -154,8 +159,21 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         bail!("--duration {duration}: must be positive");
     }
     let t = Instant::now();
-    let mut sim = Simulation::new(&sys, service::rom_options(&cfg, &sys), sim_spec(&cfg, duration))
-        .context("computing the true motion")?;
+    let truth = match &cfg.simulate.truth_system {
+        Some(file) => Some(
+            files::load_system(&cfg.dir.join(file))
+                .map(|l| l.system)
+                .with_context(|| format!("{}: [simulate] truth_system = {file:?}", cfg.path.display()))?,
+        ),
+        None => None,
+    };
+    let mut sim = Simulation::new(
+        &sys,
+        truth.as_ref(),
+        service::rom_options(&cfg, &sys),
+        sim_spec(&cfg, duration),
+    )
+    .context("computing the true motion")?;
     tracing::info!(seconds = t.elapsed().as_secs_f64(), "true motion computed");
     let n_bodies = sim.n_bodies;
     let names: Vec<String> = sys

@@ -20,9 +20,10 @@
 //!
 //! with e the model error as a fraction of the motion's own standard deviation (config
 //! `forecast.model_error`, calibrated in replays: README). The ratio sigma(t) / sqrt(sum_c v_c) is the
-//! normalized RMS error the forecast expects at t; a vessel's forecast is trusted over the first run of
-//! leads at which that ratio is at most `forecast.trusted_nrmse` for each of heave, roll and pitch that
-//! moves enough to matter ([`SIGNIFICANT`]).
+//! normalized RMS error the forecast expects at t; a vessel's forecast is trusted over the longest run
+//! of leads (the earliest of equal ones) at which that ratio is at most `forecast.trusted_nrmse` for
+//! each of heave, roll and pitch that moves enough to matter ([`SIGNIFICANT`]): the initial state can
+//! make the first seconds trusted and a radar's blind zone the next ones not.
 //!
 //! Conventions (DESIGN.md section 1): DOF order surge, sway, heave, roll, pitch, yaw per vessel, m and
 //! rad; headings of waves relative to the vessel's +x, travel-to, counterclockwise; series-major output
@@ -281,8 +282,7 @@ pub fn spread(
                 .iter()
                 .all(|&i| sigma[i * n + k] <= opts.trusted_nrmse * judged[i])
         };
-        if let Some(first) = (0..n).find(|&k| trusted(k)) {
-            let last = (first..n).take_while(|&k| trusted(k)).last().unwrap_or(first);
+        if let Some((first, last)) = longest_run((0..=n.saturating_sub(1)).map(trusted)) {
             from_s[b] = first as f64 * dt_s;
             to_s[b] = last as f64 * dt_s;
         }
@@ -295,10 +295,29 @@ pub fn spread(
     }
 }
 
+/// The first and last index of the longest run of `true` (the earliest of equal ones), if any.
+fn longest_run(flags: impl Iterator<Item = bool>) -> Option<(usize, usize)> {
+    let mut best: Option<(usize, usize)> = None;
+    let mut start = None;
+    for (k, ok) in flags.chain(std::iter::once(false)).enumerate() {
+        match (ok, start) {
+            (true, None) => start = Some(k),
+            (false, Some(s)) => {
+                if best.is_none_or(|(f, l)| k - 1 - s > l - f) {
+                    best = Some((s, k - 1));
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    best
+}
+
 /// The leads at which past forecasts are checked against the motion that followed, s (those within
 /// the forecast's length): the model error is learnt as a function of lead.
-pub const CHECK_LEADS_S: [f64; 12] = [
-    5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0, 180.0, 300.0,
+pub const CHECK_LEADS_S: [f64; 13] = [
+    0.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0, 180.0, 300.0,
 ];
 /// The prior model error (`forecast.model_error`) holds up to this lead and grows in proportion
 /// beyond it, as a phase error does (an inversion's frequency error): until the daemon has checked
@@ -310,8 +329,9 @@ pub const CHECK_MEMORY: f64 = 600.0;
 pub const CHECK_MIN: usize = 60;
 /// The smallest model error the estimate gives (a forecast is never taken as perfect).
 const MIN_MODEL_ERROR: f64 = 0.02;
-/// A series is learnt only where the measured motion's variance is this many times the sensor's
-/// noise variance (a motion buried in noise tells nothing of the forecast's error: the prior stays).
+/// A series' measured motion counts (judges the span, floors the model error) only where its variance
+/// is this many times the sensor's noise variance; its forecast's error is learnt either way (a model
+/// that moves a quiet series has an error the prior, a fraction of the model's motion, would miss).
 const MIN_SIGNAL_TO_NOISE: f64 = 9.0;
 
 /// A forecast waiting to be checked: at each check lead (the first `values.len()` of
@@ -444,12 +464,18 @@ impl ModelError {
             .map(|i| {
                 (0..CHECK_LEADS_S.len())
                     .map(|j| {
-                        let motion = self.motion_var(i);
-                        if self.checks[j] < CHECK_MIN || motion.is_nan() {
+                        if self.checks[j] < CHECK_MIN {
                             return f64::NAN;
                         }
-                        // never below MIN_MODEL_ERROR of the motion
-                        self.excess[j][i].max(MIN_MODEL_ERROR * MIN_MODEL_ERROR * motion)
+                        // never below MIN_MODEL_ERROR of the motion (where it stands out of the
+                        // noise: a quiet series' error is learnt all the same)
+                        let motion = self.motion_var(i);
+                        let floor = if motion.is_nan() {
+                            0.0
+                        } else {
+                            MIN_MODEL_ERROR * MIN_MODEL_ERROR * motion
+                        };
+                        self.excess[j][i].max(floor)
                     })
                     .collect()
             })
@@ -613,7 +639,7 @@ mod tests {
         let prior = ModelErrorCurve::prior(0.33, 1);
         assert!(m.curve().var[0].iter().all(|v| v.is_nan()));
         let dt = 0.5;
-        let n = 61; // 30 s: checked at 5, 10, 20 and 30 s
+        let n = 61; // 30 s: checked at 0, 5, 10, 20 and 30 s
         let values = vec![0.0; n];
         let sigma = vec![(0.25f64 + 0.33 * 0.33).sqrt(); n];
         // checks fall on whole seconds: the motion alternates between them
@@ -623,10 +649,10 @@ mod tests {
             m.record(t, dt, (&values, &sigma), &[1.0], &prior);
             m.observe(t, |at| Some(vec![truth(at)]));
         }
-        assert!(m.checks()[..4].iter().all(|c| *c >= CHECK_MIN), "{:?}", m.checks());
-        assert_eq!(m.checks()[4], 0);
+        assert!(m.checks()[..5].iter().all(|c| *c >= CHECK_MIN), "{:?}", m.checks());
+        assert_eq!(m.checks()[5], 0);
         let c = m.curve();
-        for j in 0..4 {
+        for j in 0..5 {
             assert!((c.var[0][j] - 0.24).abs() < 0.01, "{:?}", c.var);
         }
         // the motion as measured: 0.7 either way
@@ -634,7 +660,7 @@ mod tests {
         assert!((c.motion_sigma(0, 1.0) - 0.7).abs() < 0.01);
         // unchecked leads keep the prior (0.33 of the model's motion, growing in proportion to the
         // lead beyond 30 s, taken at the lead asked); between check leads linear
-        assert!(c.var[0][5].is_nan());
+        assert!(c.var[0][6].is_nan());
         assert!((c.at(0, 60.0, 1.0) - 0.66 * 0.66).abs() < 1e-12);
         assert!((c.at(0, 37.5, 1.0) - 0.5 * (0.24 + (0.33f64 * 1.25).powi(2))).abs() < 0.01);
         // a motion that is not there, or not finite, is no check
@@ -643,6 +669,41 @@ mod tests {
         m.observe(400.0, |_| Some(vec![f64::NAN]));
         m.observe(400.0, |_| None);
         assert_eq!(m.checks(), &before[..]);
+    }
+
+    #[test]
+    fn a_quiet_series_error_is_learnt_all_the_same() {
+        // the sensor's noise 0.01; the motion as measured +-0.02 (under 9 times the noise's variance):
+        // the forecast of 0 errs by 0.02, of which 0.01 is the noise's
+        let mut m = ModelError::new(0.1, vec![1e-4]);
+        let prior = ModelErrorCurve::prior(0.1, 1);
+        let (dt, n) = (0.5, 61);
+        let values = vec![0.0; n];
+        let sigma = vec![0.0; n];
+        let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.02 } else { -0.02 };
+        for j in 0..200 {
+            let t = j as f64;
+            m.record(t, dt, (&values, &sigma), &[1e-3], &prior);
+            m.observe(t, |at| Some(vec![truth(at)]));
+        }
+        let c = m.curve();
+        assert!(c.motion_var[0].is_nan(), "buried in the noise: not the span's judge");
+        for j in 0..4 {
+            assert!((c.var[0][j] - 3e-4).abs() < 1e-5, "{:?}", c.var);
+        }
+        // not the prior's 0.1 of the model's 1e-3
+        assert!((c.at(0, 10.0, 1e-6) - 3e-4).abs() < 1e-5);
+    }
+
+    #[test]
+    fn the_span_is_the_longest_trusted_run() {
+        let run = |s: &str| longest_run(s.chars().map(|c| c == '1'));
+        // the initial state's first seconds, a blind zone's next ones, then the radar's waves
+        assert_eq!(run("1100011111100"), Some((5, 10)));
+        assert_eq!(run("111000111"), Some((0, 2)), "the earliest of equal runs");
+        assert_eq!(run("0001"), Some((3, 3)));
+        assert_eq!(run("000"), None);
+        assert_eq!(run(""), None);
     }
 
     #[test]

@@ -254,6 +254,9 @@ pub struct SimulateConfig {
     pub seed: u64,
     /// Model error: the true linear damping is this factor times the model's.
     pub damping_factor: f64,
+    /// The truth's vessel system file (another database of the same bodies, its own damping), relative
+    /// to the config file; None: the model's own (`[system] file`).
+    pub truth_system: Option<String>,
     pub ramp_s: f64,
     /// The data clock at the start, UNIX seconds (None: the wall clock at the start).
     pub start_unix_s: Option<f64>,
@@ -318,6 +321,7 @@ impl Default for SimulateConfig {
             speed: 1.0,
             seed: 1,
             damping_factor: 1.0,
+            truth_system: None,
             ramp_s: 30.0,
             start_unix_s: None,
             sea: SeaConfig::default(),
@@ -342,6 +346,8 @@ pub struct SeaConfig {
     pub components: usize,
     pub omega_min_rad_s: f64,
     pub omega_max_rad_s: f64,
+    /// The radar sees the second-order bound waves too.
+    pub bound_waves: bool,
 }
 
 impl Default for SeaConfig {
@@ -355,6 +361,7 @@ impl Default for SeaConfig {
             components: 200,
             omega_min_rad_s: 0.3,
             omega_max_rad_s: 1.4,
+            bound_waves: true,
         }
     }
 }
@@ -376,6 +383,8 @@ pub struct RadarConfig {
     pub blind_radius_m: f64,
     /// A sector masked by the superstructure: relative bearings [from, to], deg clockwise from the bow.
     pub masked_sector_deg: Option<[f64; 2]>,
+    /// The antenna's height above the water, m: cells behind crests are shadowed (0: no shadowing).
+    pub antenna_height_m: f64,
 }
 
 impl Default for RadarConfig {
@@ -388,8 +397,9 @@ impl Default for RadarConfig {
             snapshots: 3,
             record_grid_every: 15,
             output: "components".into(),
-            blind_radius_m: 0.0,
+            blind_radius_m: 200.0,
             masked_sector_deg: None,
+            antenna_height_m: 30.0,
         }
     }
 }
@@ -402,6 +412,10 @@ pub struct ImuConfig {
     pub noise_rad: f64,
     pub bias_m: f64,
     pub bias_rad: f64,
+    /// A wandering bias (first-order Gauss-Markov): standard deviations and correlation time.
+    pub drift_m: f64,
+    pub drift_rad: f64,
+    pub drift_time_s: f64,
 }
 
 impl Default for ImuConfig {
@@ -412,6 +426,9 @@ impl Default for ImuConfig {
             noise_rad: 0.0005,
             bias_m: 0.0,
             bias_rad: 0.0,
+            drift_m: 0.02,
+            drift_rad: 0.0003,
+            drift_time_s: 600.0,
         }
     }
 }
@@ -792,6 +809,10 @@ pub const BOUNDS: &[Bound] = &[
     closed("simulate.imu.noise_rad", 0.0, 1.0, "rad"),
     closed("simulate.imu.bias_m", -10.0, 10.0, "m"),
     closed("simulate.imu.bias_rad", -1.0, 1.0, "rad"),
+    closed("simulate.imu.drift_m", 0.0, 10.0, "m"),
+    closed("simulate.imu.drift_rad", 0.0, 1.0, "rad"),
+    positive("simulate.imu.drift_time_s", 86_400.0, "s"),
+    closed("simulate.radar.antenna_height_m", 0.0, 200.0, "m"),
     // the radar's range at most (simulate.radar.radius_m's bound)
     closed("simulate.radar.blind_radius_m", 0.0, 20000.0, "m"),
     // rom::model::MAX_SPEED_M_S (50 knots); astern allowed
@@ -887,6 +908,10 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.imu.noise_rad", s.imu.noise_rad),
         one("simulate.imu.bias_m", s.imu.bias_m),
         one("simulate.imu.bias_rad", s.imu.bias_rad),
+        one("simulate.imu.drift_m", s.imu.drift_m),
+        one("simulate.imu.drift_rad", s.imu.drift_rad),
+        one("simulate.imu.drift_time_s", s.imu.drift_time_s),
+        one("simulate.radar.antenna_height_m", s.radar.antenna_height_m),
         one("simulate.radar.blind_radius_m", s.radar.blind_radius_m),
         one("simulate.track.speed_m_s", s.track.speed_m_s),
         (

@@ -972,7 +972,7 @@ impl Engine {
                     Some(x)
                 });
                 // the learnt model error in the log: when first learnt, then every CHECK_MEMORY checks
-                let c30 = self.model_error.checks()[3];
+                let c30 = self.model_error.checks()[4];
                 if c30 != self.model_error_logged && (c30 == 60 || c30.is_multiple_of(600)) && c30 > 0 {
                     self.model_error_logged = c30;
                     let curve = self.model_error.curve();

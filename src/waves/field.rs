@@ -258,17 +258,35 @@ impl WaveField {
     /// Elevation at `points` (earth frame, m) at time `t_s`, into `out`.
     pub fn elevation(&self, points: &[[f64; 2]], t_s: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|e| *e = 0.0);
+        self.each_term(points, t_s, |i, a0, cs, sn| {
+            // Re{a0 exp(-i ph)}
+            out[i] += a0.re * cs + a0.im * sn;
+        });
+    }
+
+    /// The elevation's analytic signal at `points` and `t_s`: the elevation (real part) and its Hilbert
+    /// transform (imaginary part: every component a quarter period on), into `out`.
+    pub fn analytic_elevation(&self, points: &[[f64; 2]], t_s: f64, out: &mut [Complex64]) {
+        out.iter_mut().for_each(|e| *e = Complex64::default());
+        self.each_term(points, t_s, |i, a0, cs, sn| {
+            // a0 exp(-i ph)
+            out[i] += Complex64::new(a0.re * cs + a0.im * sn, a0.im * cs - a0.re * sn);
+        });
+    }
+
+    /// Calls `f(point, a0, cos ph, sin ph)` for every component and point: a0 the component's complex
+    /// amplitude at the reference point and `t_s`, ph its phase k . (p - reference).
+    fn each_term(&self, points: &[[f64; 2]], t_s: f64, mut f: impl FnMut(usize, Complex64, f64, f64)) {
         let dt = t_s - self.time_s;
         for c in &self.components {
             let k = self.wave_number(c.omega_rad_s);
             let (s, co) = c.direction_rad.sin_cos();
             let (kx, ky) = (k * co, k * s);
             let a0 = c.amplitude_m * Complex64::from_polar(1.0, c.omega_rad_s * dt);
-            for (p, e) in points.iter().zip(out.iter_mut()) {
+            for (i, p) in points.iter().enumerate() {
                 let ph = kx * (p[0] - self.reference_m[0]) + ky * (p[1] - self.reference_m[1]);
                 let (sn, cs) = ph.sin_cos();
-                // Re{a0 exp(-i ph)}
-                *e += a0.re * cs + a0.im * sn;
+                f(i, a0, cs, sn);
             }
         }
     }

@@ -11,9 +11,9 @@
 //!
 //! Radar scans ([`from_scans`]): snapshots whose cells may be invalid (NaN: the blind zone around the
 //! antenna, cells shadowed behind crests, a sector masked by the superstructure, beyond the range),
-//! on a grid that may be turned in the earth frame. Invalid cells are taken as zero (as outside a
-//! radar's disc), and the field's region is what the cells valid in every snapshot covered
-//! ([`Region::Coverage`]).
+//! on a grid that may be turned in the earth frame. Each snapshot's invalid cells are taken as zero
+//! (as outside a radar's disc), and the field's region is what the cells valid in any snapshot
+//! covered ([`Region::Coverage`]).
 //!
 //! Probe: the record's FFT (the seed paper's method), long-crested along a given direction, amplitudes
 //! referred to the probe and the record's last sample.
@@ -183,7 +183,7 @@ impl GridFrame {
 /// noise by 1 / sqrt(share) and more (3 scans 2 s apart: the bins within about 0.1 rad/s of 1.57 rad/s).
 pub const SEPARATION_FLOOR: f64 = 0.1;
 
-/// The least share of a scan's cells that must be valid in every snapshot.
+/// The least share of each snapshot's cells that must be valid.
 pub const MIN_VALID_SHARE: f64 = 0.05;
 
 /// A field from radar scans with invalid (NaN) cells on a grid in `frame` ([`from_grids`] on the
@@ -199,26 +199,25 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
             "a scan's values do not fill its {nx} x {ny} grid"
         )));
     }
-    let valid: Vec<bool> = (0..nx * ny)
-        .map(|i| grids.iter().all(|g| g.values[i].is_finite()))
-        .collect();
-    let share = valid.iter().filter(|v| **v).count() as f64 / (nx * ny).max(1) as f64;
-    if share < MIN_VALID_SHARE {
-        return Err(Error::Invalid(format!(
-            "{:.1} % of the scans' cells are valid in every snapshot: at least {:.0} % are needed",
-            100.0 * share,
-            100.0 * MIN_VALID_SHARE
-        )));
+    for (s, g) in grids.iter().enumerate() {
+        let share = g.values.iter().filter(|v| v.is_finite()).count() as f64 / (nx * ny).max(1) as f64;
+        if share < MIN_VALID_SHARE {
+            return Err(Error::Invalid(format!(
+                "snapshot {s}: {:.1} % of its cells are valid: at least {:.0} % are needed",
+                100.0 * share,
+                100.0 * MIN_VALID_SHARE
+            )));
+        }
     }
+    // each snapshot's own invalid cells are zero (shadows move with the crests: the cells valid in
+    // every snapshot are fewer than any one scan's)
+    let valid: Vec<bool> = (0..nx * ny)
+        .map(|i| grids.iter().any(|g| g.values[i].is_finite()))
+        .collect();
     let zeroed: Vec<Grid> = grids
         .iter()
         .map(|g| Grid {
-            values: g
-                .values
-                .iter()
-                .zip(&valid)
-                .map(|(v, ok)| if *ok { *v } else { 0.0 })
-                .collect(),
+            values: g.values.iter().map(|v| if v.is_finite() { *v } else { 0.0 }).collect(),
             ..g.clone()
         })
         .collect();

@@ -25,6 +25,8 @@ Usage: python3 make_db.py --preset ship OUTDIR      (one 180 m ship)
        python3 make_db.py --preset offset-box OUTDIR   (the barge placed at x = 40 m; RAO at off-grid headings)
        python3 make_db.py --preset messy-pair OUTDIR   (two 12 m boxes 6.5 m apart, no lid: B indefinite above 3 rad/s)
        python3 make_db.py --preset barge-speeds OUTDIR (the barge at 0, 2, 4 m/s and, directly, 3 m/s)
+       python3 make_db.py --preset pair-direct OUTDIR  (the pair, direct formulation: the two-ship demo's truth)
+       python3 make_db.py --preset ship-direct OUTDIR  (the ship, direct formulation: the one-ship demo's truth)
 
 Forward speed (a preset with `speeds`, e.g. barge-speeds) writes one file set per speed, <stem>.1/.3/.hst,
 the zero-speed one named by system.toml's `wamit`, the speed set listed in system.toml's [[database]]
@@ -291,7 +293,10 @@ PRESETS["pair-fine-surface-lid"] = _pair_to(0.01, panel_m=2.0, lid="surface")
 # 0.68 % at the lighter's 1.23 rad/s resonance), but the state space's 2.0 % (lighter sway, heading 0,
 # 0.05 rad/s; the pair preset 1.37 %), and with the database's own A_inf the convolution's floor is 2.32 %
 # at 1.23 rad/s (the pair preset 2.11 %): no more consistent there, only luckier. Not swapped in.
+# Since session 21 it is the two-ship demo's truth (config/vessels/pair/truth: `shipcast simulate`'s true
+# vessels are not the forecaster's database), and ship-direct the one-ship demo's (config/vessels/ship/truth).
 PRESETS["pair-direct"] = dict(PRESETS["pair"], bem_method="direct")
+PRESETS["ship-direct"] = dict(PRESETS["ship"], bem_method="direct")
 # the pair preset with the Green function's singularities integrated for high frequencies (an experiment,
 # session 12, 886 s): Kramers-Kronig worst A 1.26 % in band (the pair preset 1.15 %), the convolution's floor
 # 1.21 %, the state space's 1.50 % (the pair preset 1.14 / 1.37 %). Not usable.
