@@ -85,6 +85,11 @@ fn forecasts(drift_window_s: f64) -> Vec<Forecast> {
 
 /// RMS error at `LEAD_S` against the log's truth of (vessel, dof).
 fn rms_error(fs: &[Forecast], vessel: usize, dof: usize) -> f64 {
+    rms_error_at(fs, vessel, dof, LEAD_S)
+}
+
+/// RMS error at `lead_s` against the log's truth of (vessel, dof).
+fn rms_error_at(fs: &[Forecast], vessel: usize, dof: usize, lead_s: f64) -> f64 {
     let mut truth = BTreeMap::new();
     for (_, r) in &log().records {
         if let Record::Truth(m) = r
@@ -95,7 +100,7 @@ fn rms_error(fs: &[Forecast], vessel: usize, dof: usize) -> f64 {
     }
     let (mut se, mut n) = (0.0, 0usize);
     for f in fs {
-        let t = f.header.issue_time_s + LEAD_S;
+        let t = f.header.issue_time_s + lead_s;
         if let (Some(x), Some(tr)) = (f.at(vessel, dof, t), truth.get(&((t * 1000.0).round() as i64))) {
             se += (x - tr).powi(2);
             n += 1;
@@ -103,6 +108,41 @@ fn rms_error(fs: &[Forecast], vessel: usize, dof: usize) -> f64 {
     }
     assert!(n > 100, "{n} forecasts met the truth");
     (se / n as f64).sqrt()
+}
+
+/// The moored lighter's roll at lead 0 and 5 s, RMS error over the truth's standard deviation, in the
+/// second half of the log (the estimator's bias and the model's mean averaged), at most: the lines
+/// and fenders give it a mean heel in waves, which the estimator takes off as a sensor's bias; the
+/// model's own mean in waves goes back on (measured 0.03 and 0.06; over the whole log 0.56 and 0.32
+/// without it).
+const HEELED_START_NRMSE: f64 = 0.2;
+
+#[test]
+fn a_moored_vessel_s_forecast_starts_from_its_mean_heel() {
+    let fs: Vec<Forecast> = forecasts(shipcast::rom::drift::DRIFT_WINDOW_S);
+    let start = log().records.first().map(|r| r.0).unwrap();
+    let late: Vec<Forecast> = fs
+        .into_iter()
+        .filter(|f| f.header.issue_time_s - start >= LOG_S / 2.0)
+        .collect();
+    let truth: Vec<f64> = log()
+        .records
+        .iter()
+        .filter_map(|(t, r)| match r {
+            Record::Truth(m) if m.vessel == 1 && *t - start >= LOG_S / 2.0 => Some(m.x[3]),
+            _ => None,
+        })
+        .collect();
+    let mean = truth.iter().sum::<f64>() / truth.len() as f64;
+    let std = (truth.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / truth.len() as f64).sqrt();
+    for lead_s in [0.0, 5.0] {
+        let e = rms_error_at(&late, 1, 3, lead_s) / std;
+        eprintln!(
+            "lighter roll at {lead_s} s lead: NRMSE {e:.3} (the truth's mean heel {:.2} deg)",
+            mean.to_degrees()
+        );
+        assert!(e <= HEELED_START_NRMSE, "{lead_s} s: {e}");
+    }
 }
 
 #[test]

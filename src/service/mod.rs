@@ -141,7 +141,14 @@ pub struct Done {
     /// Each series' motion standard deviation by the band's model, and the model error the band took.
     pub motion_sigma: Vec<f64>,
     pub model_error: spread::ModelErrorCurve,
+    /// The forecast may teach the model error: its waves were trusted and its band known (a forecast
+    /// with no trusted span teaches all the same: its error is the model's).
+    pub teaches: bool,
 }
+
+/// A forecast's leads from this one on are settled (past a roll's decay, 1 / (zeta w_n) = 47 s at 5 %
+/// of critical and 0.43 rad/s): their mean is the model's own mean in waves, s.
+pub const SETTLED_LEAD_S: f64 = 60.0;
 
 /// The speed steps the compute thread rebuilds a speed-dependent model at, m/s: the forward speed from
 /// navigation is rounded to it (B_U U and C_UQ U^2 then within 0.125 m/s of the speed's).
@@ -326,6 +333,7 @@ impl Computer {
                     compute_ms,
                     error: None,
                     dropped_wave_share,
+                    teaches: job.trustworthy && !motion_sigma.is_empty(),
                     motion_sigma,
                     model_error: job.model_error,
                 }
@@ -338,6 +346,7 @@ impl Computer {
                 dropped_wave_share: 0.0,
                 motion_sigma: vec![],
                 model_error: job.model_error,
+                teaches: false,
             },
         }
     }
@@ -617,6 +626,12 @@ pub struct Engine {
     /// at 30 s when it was last logged.
     model_error: spread::ModelError,
     model_error_logged: usize,
+    /// The model's own mean displacement in waves per vessel and DOF (heave, roll, pitch), and when
+    /// and over how long it was learnt (`learn_model_mean`).
+    model_mean: Vec<[f64; 6]>,
+    model_mean_time_s: Option<f64>,
+    model_mean_span_s: f64,
+    bias_time_s: f64,
 }
 
 impl Engine {
@@ -677,6 +692,10 @@ impl Engine {
             last_horizon: [0.0; MAX_VESSELS],
             state_flags: 0,
             model_error_logged: 0,
+            model_mean: vec![[0.0; 6]; n_bodies],
+            model_mean_time_s: None,
+            model_mean_span_s: 0.0,
+            bias_time_s: cfg.estimator.bias_time_s,
             model_error: spread::ModelError::new(
                 cfg.forecast.model_error,
                 // the motion sensor's noise as the estimator is told it (translations, rotations)
@@ -945,9 +964,13 @@ impl Engine {
                     fl |= flags::HISTORY_GAP;
                 }
                 known_history = known_history.min(r.known);
+                // the estimator takes its bias off (the sensor's and a mean heel alike); the
+                // model's own mean in waves goes back on
+                let bias = self.hist[b].bias();
                 for (row, &i) in self.active.iter().enumerate() {
                     if i / 6 == b && i < 6 * n_bodies {
-                        x0[row] = r.x0[i % 6];
+                        let d = i % 6;
+                        x0[row] = r.x0[d] + if bias[d] != 0.0 { self.model_mean[b][d] } else { 0.0 };
                         v0[row] = r.v0[i % 6];
                         for (m, v) in r.velocities.iter().enumerate() {
                             velocities[m][row] = v[i % 6];
@@ -1113,12 +1136,13 @@ impl Engine {
                 }
                 self.counters.forecasts += 1;
                 self.last_forecast_time = header.issue_time_s;
-                // only forecasts the daemon trusts teach it the model's error (an untrusted one's
-                // error is its waves')
+                // only forecasts whose waves the daemon trusts teach it the model's error (an
+                // untrusted field's error is its waves'), with or without a trusted span
                 let n = (header.steps as usize + 1) * header.n_series as usize;
-                let trusted = header.horizon_s[..(header.n_vessels as usize).min(MAX_VESSELS)]
-                    .iter()
-                    .all(|h| *h > 0.0);
+                let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share;
+                if values.len() == 2 * n {
+                    self.learn_model_mean(&header, &values[..n]);
+                }
                 if values.len() == 2 * n && trusted {
                     self.model_error.record(
                         header.issue_time_s,
@@ -1135,6 +1159,40 @@ impl Engine {
                 self.state_flags |= flags::NUMERICAL;
                 tracing::warn!("forecast abandoned: {}", e.unwrap_or_default());
                 None
+            }
+        }
+    }
+
+    /// The model's own mean displacement in waves (heave, roll, pitch), from a forecast's settled leads
+    /// (at least [`SETTLED_LEAD_S`]): averaged over [`crate::service::config::EstimatorConfig`]'s
+    /// `bias_time_s`, as the estimator averages the measured motion. Lines and fenders give a moored
+    /// vessel a mean heel in waves, which the estimator's bias also holds: the bias less this mean is
+    /// the sensor's.
+    fn learn_model_mean(&mut self, header: &ForecastHeader, values: &[f64]) {
+        let steps = header.steps as usize;
+        let first = (SETTLED_LEAD_S / header.dt_s).ceil() as usize;
+        if first > steps || values.len() != (steps + 1) * 6 * self.n_bodies {
+            return;
+        }
+        let dt = match self.model_mean_time_s {
+            Some(t) => (header.issue_time_s - t).max(0.0),
+            None => 0.0,
+        };
+        self.model_mean_time_s = Some(header.issue_time_s);
+        self.model_mean_span_s += dt;
+        let w = if self.model_mean_span_s <= 0.0 {
+            1.0
+        } else {
+            (dt / self.bias_time_s.min(self.model_mean_span_s)).min(1.0)
+        };
+        for b in 0..self.n_bodies {
+            for d in 2..5 {
+                let series = &values[(6 * b + d) * (steps + 1)..(6 * b + d + 1) * (steps + 1)];
+                let mean = series[first..].iter().sum::<f64>() / (steps + 1 - first) as f64;
+                if mean.is_finite() {
+                    let m = &mut self.model_mean[b][d];
+                    *m += w * (mean - *m);
+                }
             }
         }
     }

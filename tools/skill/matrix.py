@@ -5,7 +5,7 @@ forecast is trusted"). Each case is `shipcast simulate --record` of the config w
 written to OUTDIR/matrix.md, each case's report kept in OUTDIR/<case>.
 
 Usage: python3 tools/skill/matrix.py [--shipcast target/release/shipcast] [--config config/shipcast.toml]
-                                     [--duration 1800] [--only CASE ...] OUTDIR
+                                     [--duration 1800] [--only CASE,CASE] OUTDIR
 
 Standard library only. What is scored against what: see `shipcast replay --help` (the truth motion the
 simulator recorded)."""
@@ -52,15 +52,18 @@ def summarize(j):
     for vessel, dofs in j["vessels"].items():
         span = (j["trusted_from_s"][vessel], j["trusted_horizon_s"][vessel])
         inside = [i for i, l in enumerate(leads) if l <= span[1]] if span[1] > 0 else []
-        cov = {}
+        cov, cov_all = {}, {}
         for d in DOFS:
-            c = [dofs[d]["coverage_90"][i] for i in inside if dofs[d]["coverage_90"][i] == dofs[d]["coverage_90"][i]]
+            finite = lambda idx: [dofs[d]["coverage_90"][i] for i in idx if dofs[d]["coverage_90"][i] == dofs[d]["coverage_90"][i]]
+            c = finite(inside)
             cov[d] = (min(c), max(c)) if c else None
+            c = finite(range(len(leads)))
+            cov_all[d] = (min(c), max(c)) if c else None
         rows.append(dict(
             vessel=vessel, span=span,
             corr={d: (at_lead(dofs[d]["correlation"], leads, 30), at_lead(dofs[d]["correlation"], leads, 60)) for d in DOFS},
             nrmse_end={d: at_lead(dofs[d]["nrmse"], leads, span[1]) if span[1] > 0 else None for d in ("heave", "roll")},
-            cov=cov))
+            cov=cov, cov_all=cov_all))
     return rows
 
 
@@ -74,17 +77,17 @@ def main():
     ap.add_argument("--shipcast", default="target/release/shipcast")
     ap.add_argument("--config", default="config/shipcast.toml")
     ap.add_argument("--duration", type=float, default=1800.0)
-    ap.add_argument("--only", nargs="*", help="case names")
+    ap.add_argument("--only", help="case names, comma-separated")
     a = ap.parse_args()
     os.makedirs(a.outdir, exist_ok=True)
     lines = [
         f"Config `{a.config}`, {a.duration:.0f} s per case, `{' '.join(sys.argv)}`.",
         "",
-        "| case | vessel | span (median, s) | heave corr 30 / 60 s | roll corr 30 / 60 s | heave / roll NRMSE at the span's end | coverage_90 inside the span: heave; roll; pitch |",
-        "|---|---|---|---|---|---|---|",
+        "| case | vessel | span (median, s) | heave corr 30 / 60 s | roll corr 30 / 60 s | heave / roll NRMSE at the span's end | coverage_90 inside the span: heave; roll; pitch | coverage_90 at every lead: heave; roll; pitch |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for name, what, keys in CASES:
-        if a.only and name not in a.only:
+        if a.only and name not in a.only.split(","):
             continue
         env = dict(os.environ, **{f"SHIPCAST_{k}": v for k, v in keys.items()})
         log = os.path.join(a.outdir, f"{name}.mcap")
@@ -97,7 +100,8 @@ def main():
         for r in summarize(j):
             nr = r["nrmse_end"]
             nrmse = "no span" if nr["heave"] is None else f"{nr['heave']:.2f} / {nr['roll']:.2f}"
-            cov = "; ".join("-" if r["cov"][d] is None else f"{r['cov'][d][0]:.2f}-{r['cov'][d][1]:.2f}" for d in DOFS)
+            span_of = lambda c: "; ".join("-" if c[d] is None else f"{c[d][0]:.2f}-{c[d][1]:.2f}" for d in DOFS)
+            cov = span_of(r["cov"]) + " | " + span_of(r["cov_all"])
             lines.append(f"| {name}: {what} | {r['vessel']} | {r['span'][0]:.0f}-{r['span'][1]:.0f} | "
                          f"{fmt_pair(r['corr']['heave'])} | {fmt_pair(r['corr']['roll'])} | {nrmse} | {cov} |")
         print(f"{name}: {time.time() - t:.0f} s", file=sys.stderr)
