@@ -451,6 +451,11 @@ fn scans(masked: impl Fn(f64, f64) -> bool) -> Vec<shipcast::waves::observe::Gri
 }
 
 fn scan_horizon(masked: impl Fn(f64, f64) -> bool) -> f64 {
+    horizon::of_field(&scan_field(masked), [0.0, 0.0], [0.0, 0.0], 0.0).horizon_s
+}
+
+/// The field of [`scans`] inverted as the daemon does.
+fn scan_field(masked: impl Fn(f64, f64) -> bool) -> WaveField {
     use shipcast::waves::observe::{GridFrame, GridOptions, from_scans};
     let grids = scans(masked);
     let frame = GridFrame {
@@ -467,7 +472,21 @@ fn scan_horizon(masked: impl Fn(f64, f64) -> bool) -> f64 {
     };
     let f = from_scans(&grids, frame, &opts).unwrap();
     assert!(matches!(f.region, Region::Coverage { .. }));
-    horizon::of_field(&f, [0.0, 0.0], [0.0, 0.0], 0.0).horizon_s
+    f
+}
+
+/// A radar's blind zone (200 m around the antenna) is not inside the scans' region, to a cell (the
+/// map's 15.6 m): the waves crossing it are known from where they were seen; a map without one has
+/// none.
+#[test]
+fn a_blind_zone_is_not_inside_the_scans_region() {
+    let inner = |f: WaveField| match f.region {
+        Region::Coverage { inner_m, .. } => inner_m,
+        _ => unreachable!(),
+    };
+    assert_eq!(inner(scan_field(|_, _| false)), 0.0);
+    let blind = inner(scan_field(|x, y| x.hypot(y) < 200.0));
+    assert!((blind - 200.0).abs() < 2000.0 / 128.0, "{blind}");
 }
 
 /// A sector the superstructure masks on the side the waves come from (west: they travel east) halves

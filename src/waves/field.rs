@@ -44,10 +44,11 @@ pub enum Region {
     Point { at_m: [f64; 2], window_s: f64 },
     /// What a radar's valid cells covered, seen from `centre_m` (earth frame): in each of
     /// [`COVERAGE_SECTORS`] equal sectors of direction (sector j spans j..j+1 times 360 / sectors deg,
-    /// counterclockwise from east), the farthest valid cell, m (0: nothing seen that way). A blind zone
-    /// around the centre does not shorten a sector's reach.
+    /// counterclockwise from east), the farthest valid cell, m (0: nothing seen that way); nothing
+    /// within `inner_m` of the centre was seen (a radar's blind zone).
     Coverage {
         centre_m: [f64; 2],
+        inner_m: f64,
         ranges_m: [f64; COVERAGE_SECTORS],
     },
 }
@@ -62,10 +63,15 @@ impl Region {
             Region::Everywhere => true,
             Region::Disc { centre_m, radius_m } => (p[0] - centre_m[0]).hypot(p[1] - centre_m[1]) <= radius_m,
             Region::Point { .. } => false,
-            Region::Coverage { centre_m, ranges_m } => {
+            Region::Coverage {
+                centre_m,
+                inner_m,
+                ranges_m,
+            } => {
                 let (dx, dy) = (p[0] - centre_m[0], p[1] - centre_m[1]);
                 let j = coverage_sector(dy.atan2(dx));
-                dx.hypot(dy) <= ranges_m[j]
+                let r = dx.hypot(dy);
+                r >= inner_m && r <= ranges_m[j]
             }
         }
     }

@@ -35,38 +35,10 @@ pub struct Horizon {
     pub noncausal_s: f64,
 }
 
-/// Steps of [`coverage_exit`]'s march, m (longer on a region so large that it would take more than
+/// Steps of [`coverage_span`]'s march, m (longer on a region so large that it would take more than
 /// [`COVERAGE_STEPS`]).
 const COVERAGE_STEP_M: f64 = 10.0;
 const COVERAGE_STEPS: f64 = 400.0;
-
-/// Lead time at which the water reaching a vessel at `position` (moving relative to a group at `rel`)
-/// was outside a coverage region at t0: the first t at which `position + rel t` leaves it, marched in
-/// steps of [`COVERAGE_STEP_M`] or more (0 if the vessel starts outside).
-fn coverage_exit(region: &Region, position: [f64; 2], rel: [f64; 2]) -> f64 {
-    let Region::Coverage { ranges_m, .. } = region else {
-        return 0.0;
-    };
-    if !region.contains(position) {
-        return 0.0;
-    }
-    let speed = rel[0].hypot(rel[1]);
-    if speed <= 0.0 {
-        return f64::INFINITY;
-    }
-    let reach = 2.0 * ranges_m.iter().fold(0.0f64, |m, r| m.max(*r)) + COVERAGE_STEP_M;
-    // at most COVERAGE_STEPS steps whatever the region's size
-    let dt = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS) / speed;
-    let mut t = 0.0;
-    while t * speed <= reach {
-        let next = t + dt;
-        if !region.contains([position[0] + rel[0] * next, position[1] + rel[1] * next]) {
-            return t;
-        }
-        t = next;
-    }
-    t
-}
 
 /// The horizon from (weight, lead time, omega, direction, c_g) of every part of the field.
 fn quantile(mut parts: Vec<(f64, f64, f64, f64, f64)>, noncausal_s: f64) -> Horizon {
@@ -109,7 +81,8 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
                     radius_m,
                     rel,
                 )[1],
-                Region::Coverage { .. } => coverage_exit(&field.region, position_m, rel),
+                // the end of the span its water is inside it (behind a blind zone too)
+                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel)[1],
                 Region::Point { at_m, .. } => {
                     // a probe: the group reaches the (stationary) vessel after travelling from it
                     let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
@@ -145,10 +118,10 @@ fn disc_span(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> [f64; 2] {
     if t1 < 0.0 { [0.0, 0.0] } else { [t0.max(0.0), t1] }
 }
 
-/// [`disc_span`] for a coverage region, marched as [`coverage_exit`] is: the first step inside, then
-/// the first outside after it ([0, 0]: never inside within reach).
+/// [`disc_span`] for a coverage region, marched in steps of [`COVERAGE_STEP_M`] or more: the first step
+/// inside, then the first outside after it ([0, 0]: never inside within reach).
 fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2]) -> [f64; 2] {
-    let Region::Coverage { ranges_m, centre_m } = region else {
+    let Region::Coverage { ranges_m, centre_m, .. } = region else {
         return [0.0, 0.0];
     };
     let speed = rel[0].hypot(rel[1]);
@@ -354,6 +327,7 @@ mod tests {
         // a coverage of 1000 m in every sector: as the disc, to a step
         let cov = Region::Coverage {
             centre_m: [0.0, 0.0],
+            inner_m: 0.0,
             ranges_m: [1000.0; COVERAGE_SECTORS],
         };
         let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
@@ -363,6 +337,7 @@ mod tests {
         );
         let cov = Region::Coverage {
             centre_m: [1500.0, 0.0],
+            inner_m: 0.0,
             ranges_m: [1000.0; COVERAGE_SECTORS],
         };
         let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
@@ -370,6 +345,21 @@ mod tests {
             (k[0][0] - 500.0 / cg).abs() < 11.0 / cg && (k[0][1] - 2500.0 / cg).abs() < 11.0 / cg,
             "{k:?}"
         );
+        // a radar's blind zone (200 m) around the vessel: the next 200 m of water is not known, and
+        // the horizon is the far edge's
+        let cov = Region::Coverage {
+            centre_m: [0.0, 0.0],
+            inner_m: 200.0,
+            ranges_m: [1000.0; COVERAGE_SECTORS],
+        };
+        let f = field(cov);
+        let k = known_leads(&f, [0.0, 0.0], [0.0, 0.0]);
+        assert!(
+            (k[0][0] - 200.0 / cg).abs() < 11.0 / cg && (k[0][1] - 1000.0 / cg).abs() < 11.0 / cg,
+            "{k:?}"
+        );
+        let h = of_field(&f, [0.0, 0.0], [0.0, 0.0], 0.0);
+        assert!((h.wave_horizon_s - 1000.0 / cg).abs() < 11.0 / cg, "{h:?}");
     }
 
     #[test]

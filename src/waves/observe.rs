@@ -233,6 +233,12 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
     let centre_local = local.reference_m;
     let centre = frame.to_earth(centre_local[0], centre_local[1]);
     let mut ranges_m = [0.0f64; COVERAGE_SECTORS];
+    let mut nearest_m = f64::INFINITY;
+    // the grid's coarser spacing (from_grids has checked it is uniform and increasing)
+    let cell_m = [&first.x_m, &first.y_m]
+        .iter()
+        .map(|v| (v[v.len() - 1] - v[0]) / (v.len() - 1).max(1) as f64)
+        .fold(0.0f64, f64::max);
     for iy in 0..ny {
         for ix in 0..nx {
             if !valid[iy * nx + ix] {
@@ -242,6 +248,7 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
             let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
             let j = coverage_sector(dy.atan2(dx));
             ranges_m[j] = ranges_m[j].max(dx.hypot(dy));
+            nearest_m = nearest_m.min(dx.hypot(dy));
         }
     }
     let f = WaveField {
@@ -256,6 +263,9 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
         reference_m: centre,
         region: Region::Coverage {
             centre_m: centre,
+            // the blind zone: to the nearest valid cell, less half a cell's diagonal (a grid without
+            // one has none)
+            inner_m: (nearest_m - 0.5 * cell_m * std::f64::consts::SQRT_2).max(0.0),
             ranges_m,
         },
         ..local
