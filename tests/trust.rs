@@ -1,8 +1,9 @@
 //! Faulty but plausible inputs fed through the daemon's own engine (`replay::drive`, as `shipcast
 //! replay` does) (issue 26): each test pins a fault found on an earlier main and says what it did.
-//! The log: three simulated minutes of the one-ship demo (`config/one-ship.toml`), made once.
+//! The log: three simulated minutes of the one-ship demo (`config/one-ship.toml`) in the twin sea
+//! (`util::ONE_SHIP_TWIN_SEA`: faults against a clean baseline, whose forecasts are trusted), made once.
 
-use crate::util::{SimLog, simulated};
+use crate::util::{ONE_SHIP_TWIN_SEA, SimLog, simulated_with};
 use shipcast::ipc::Output;
 use shipcast::ipc::wire::{ForecastHeader, Status, flags};
 use shipcast::replay::{self, Record};
@@ -15,7 +16,15 @@ const FAULT_AT_S: f64 = 90.0;
 
 fn log() -> &'static SimLog {
     static LOG: OnceLock<SimLog> = OnceLock::new();
-    LOG.get_or_init(|| simulated("trust", "one-ship.toml", "vessels/ship/system.toml", LOG_S))
+    LOG.get_or_init(|| {
+        simulated_with(
+            "trust",
+            "one-ship.toml",
+            "vessels/ship/system.toml",
+            LOG_S,
+            &ONE_SHIP_TWIN_SEA,
+        )
+    })
 }
 
 /// The log's first time, s.

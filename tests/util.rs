@@ -18,12 +18,8 @@ pub struct SimLog {
 }
 
 /// `secs` simulated seconds of `config/<config>` (whose `[system] file` must be `system`, relative to
-/// `config/`, made absolute in a copy in scratch dir `name`), recorded and read back.
-pub fn simulated(name: &str, config: &str, system: &str, secs: f64) -> SimLog {
-    simulated_with(name, config, system, secs, &[])
-}
-
-/// [`simulated`] with the config's text replaced: each (from, to) of `edits` must be found once.
+/// `config/`, made absolute in a copy in scratch dir `name`) with its text replaced (each (from, to)
+/// of `edits` must be found once), recorded and read back.
 pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: &[(&str, &str)]) -> SimLog {
     let dir = scratch_dir(name);
     let mut text = std::fs::read_to_string(repo(&format!("config/{config}"))).unwrap();
@@ -65,6 +61,16 @@ pub const TWIN_SEA: [(&str, &str); 7] = [
     ("antenna_height_m = 30.0 ", "antenna_height_m = 0.0 "),
     ("drift_m = 0.02 ", "drift_m = 0.0 "),
     ("drift_rad = 0.0003 ", "drift_rad = 0.0 "),
+];
+
+/// [`TWIN_SEA`] for `config/one-ship.toml` (its sensors at the defaults).
+pub const ONE_SHIP_TWIN_SEA: [(&str, &str); 3] = [
+    ("truth_system = \"vessels/ship/truth/system.toml\"\n", ""),
+    ("[simulate.sea]\n", "[simulate.sea]\nbound_waves = false\n"),
+    (
+        "[simulate.radar]\n",
+        "[simulate.imu]\ndrift_m = 0.0\ndrift_rad = 0.0\n\n[simulate.radar]\nblind_radius_m = 0.0\nantenna_height_m = 0.0\n",
+    ),
 ];
 
 /// A shipped config's text with its `[simulate] truth_system` (relative to `config/`) made absolute,

@@ -16,10 +16,12 @@
 //! moved: the error of the waves after it grows from there. The standard deviation of each series
 //! at lead t is then
 //!
-//!   sigma^2(t) = 2 sum_c u_c(t) v_c + e^2 sum_c v_c,  u_c(t) = 1 unknown, 0 known, the ramp between
+//!   sigma^2(t) = k^2(t) (2 sum_c u_c(t) v_c + e^2 sum_c v_c),  u_c(t) = 1 unknown, 0 known, the ramp between
 //!
 //! with e the model error as a fraction of the motion's own standard deviation (config
-//! `forecast.model_error`, calibrated in replays: README). The ratio sigma(t) / sqrt(sum_c v_c) is the
+//! `forecast.model_error` until [`ModelError`] has learnt it from the daemon's past forecasts), and
+//! k the band's scale, learnt from the same checks so that [`BAND_QUANTILE`] of them fall inside the
+//! 90 % band (errors are not normal; 1 until learnt), never narrower than the sensor's noise. The ratio sigma(t) / sqrt(sum_c v_c) is the
 //! normalized RMS error the forecast expects at t; a vessel's forecast is trusted over the longest run
 //! of leads (the earliest of equal ones) at which that ratio is at most `forecast.trusted_nrmse` for
 //! each of heave, roll and pitch that moves enough to matter ([`SIGNIFICANT`]): the initial state can
@@ -258,10 +260,14 @@ pub fn spread(
     for i in 0..n_series {
         let (mut acc, mut rate) = (0.0, 0.0);
         for (k, (dk, dr)) in diff[i][..n].iter().zip(&slope[i][..n]).enumerate() {
-            let floor = opts.model_error.at(i, k as f64 * dt_s, total[i]);
+            let lead_s = k as f64 * dt_s;
+            let floor = opts.model_error.at(i, lead_s, total[i]);
             acc += dk;
             rate += dr;
-            sigma.push(((acc + rate * k as f64).max(0.0) + floor).sqrt());
+            let scaled = ((acc + rate * k as f64).max(0.0) + floor).sqrt() * opts.model_error.scale_at(i, lead_s);
+            // never narrower than the sensor's noise
+            let noise = opts.model_error.noise_var.get(i).copied().unwrap_or(0.0).sqrt();
+            sigma.push(scaled.max(noise));
         }
     }
     let motion_sigma: Vec<f64> = total.iter().map(|t| t.sqrt()).collect();
@@ -327,6 +333,14 @@ pub const PRIOR_LEAD_S: f64 = 30.0;
 pub const CHECK_MEMORY: f64 = 600.0;
 /// Checks at a lead before its estimate replaces the configured prior.
 pub const CHECK_MIN: usize = 60;
+/// The band's scale is learnt so that this share of the checks falls inside [-1.645, 1.645] band
+/// widths: the published 90 % band covers nine checks in ten whatever the errors' distribution.
+pub const BAND_QUANTILE: f64 = 0.9;
+/// The standard normal's two-sided 90 % quantile.
+const Z90: f64 = 1.6448536269514722;
+/// The band's learnt scale stays within these (a few odd checks do not collapse or blow it up).
+const BAND_SCALE_LIMITS: (f64, f64) = (0.5, 3.0);
+
 /// The smallest model error the estimate gives (a forecast is never taken as perfect).
 const MIN_MODEL_ERROR: f64 = 0.02;
 /// A series' measured motion counts (judges the span, floors the model error) only where its variance
@@ -345,6 +359,8 @@ struct Pending {
     /// [lead][series]
     values: Vec<Vec<f64>>,
     unknown_var: Vec<Vec<f64>>,
+    /// The band before its learnt scale, with the sensor's noise: what a check's error is measured in.
+    raw_sigma: Vec<Vec<f64>>,
 }
 
 /// The model error each series shows against lead, learnt from past forecasts checked against the
@@ -364,6 +380,8 @@ pub struct ModelError {
     pending: std::collections::VecDeque<Pending>,
     /// [lead][series]: running mean of error^2 less what is explained.
     excess: Vec<Vec<f64>>,
+    /// [lead][series]: the last [`CHECK_MEMORY`] checks' errors over their unscaled band.
+    normalized: Vec<Vec<std::collections::VecDeque<f64>>>,
     /// Checks done at each lead.
     checks: Vec<usize>,
     /// Per series, running mean and mean square of the measured motion (at the checks of the first
@@ -386,6 +404,9 @@ pub struct ModelErrorCurve {
     /// Per series, the motion sensor's noise variance: no band is narrower (a motion buried in the
     /// noise is forecast from a start the noise has moved).
     pub noise_var: Vec<f64>,
+    /// `scale[series][lead]`: the band's factor that makes [`BAND_QUANTILE`] of the checks fall
+    /// inside its 90 % (NaN: not learnt, 1).
+    pub scale: Vec<Vec<f64>>,
 }
 
 impl ModelErrorCurve {
@@ -397,6 +418,7 @@ impl ModelErrorCurve {
             prior: fraction,
             motion_var: vec![f64::NAN; n_series],
             noise_var: vec![0.0; n_series],
+            scale: vec![vec![f64::NAN]; n_series],
         }
     }
 
@@ -426,6 +448,25 @@ impl ModelErrorCurve {
         v(j - 1) + a * (v(j) - v(j - 1))
     }
 
+    /// Series i's band scale at `lead_s`: linear between the check leads, constant beyond them, 1 where
+    /// not learnt.
+    pub fn scale_at(&self, i: usize, lead_s: f64) -> f64 {
+        let Some(f) = self.scale.get(i) else {
+            return 1.0;
+        };
+        let v = |j: usize| f.get(j).copied().filter(|x| x.is_finite()).unwrap_or(1.0);
+        let l = &self.lead_s;
+        let j = l.partition_point(|x| *x <= lead_s);
+        if j == 0 || l.len() < 2 {
+            return v(0);
+        }
+        if j >= l.len() {
+            return v(l.len() - 1);
+        }
+        let a = (lead_s - l[j - 1]) / (l[j] - l[j - 1]);
+        v(j - 1) + a * (v(j) - v(j - 1))
+    }
+
     /// Series i's motion standard deviation: measured, else the model's.
     pub fn motion_sigma(&self, i: usize, model_sigma: f64) -> f64 {
         self.motion_var
@@ -446,6 +487,7 @@ impl ModelError {
             noise_var,
             pending: Default::default(),
             excess: vec![vec![0.0; n_series]; CHECK_LEADS_S.len()],
+            normalized: vec![vec![Default::default(); n_series]; CHECK_LEADS_S.len()],
             checks: vec![0; CHECK_LEADS_S.len()],
             mean: vec![0.0; n_series],
             square: vec![0.0; n_series],
@@ -480,9 +522,27 @@ impl ModelError {
                     .collect()
             })
             .collect();
+        let scale = (0..self.n_series)
+            .map(|i| {
+                (0..CHECK_LEADS_S.len())
+                    .map(|j| {
+                        let z = &self.normalized[j][i];
+                        if z.len() < CHECK_MIN {
+                            return f64::NAN;
+                        }
+                        let mut sorted: Vec<f64> = z.iter().copied().collect();
+                        sorted.sort_by(f64::total_cmp);
+                        let q =
+                            sorted[((BAND_QUANTILE * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
+                        (q / Z90).clamp(BAND_SCALE_LIMITS.0, BAND_SCALE_LIMITS.1)
+                    })
+                    .collect()
+            })
+            .collect();
         ModelErrorCurve {
             lead_s: CHECK_LEADS_S.to_vec(),
             var,
+            scale,
             prior: self.prior,
             motion_var: (0..self.n_series).map(|i| self.motion_var(i)).collect(),
             noise_var: self.noise_var.clone(),
@@ -526,6 +586,7 @@ impl ModelError {
             next: 0,
             values: vec![],
             unknown_var: vec![],
+            raw_sigma: vec![],
         };
         for &lead in &CHECK_LEADS_S {
             let k = (lead / dt_s).round() as usize;
@@ -533,14 +594,18 @@ impl ModelError {
                 break;
             }
             p.values.push((0..ns).map(|i| values[i * n + k]).collect());
+            // the band as published is the unscaled one times the scale it was made with
+            let raw: Vec<f64> = (0..ns).map(|i| sigma[i * n + k] / used.scale_at(i, lead)).collect();
             p.unknown_var.push(
                 (0..ns)
                     .map(|i| {
                         let floor = used.at(i, lead, model_motion_sigma[i] * model_motion_sigma[i]);
-                        (sigma[i * n + k].powi(2) - floor).max(0.0)
+                        (raw[i].powi(2) - floor).max(0.0)
                     })
                     .collect(),
             );
+            p.raw_sigma
+                .push((0..ns).map(|i| (raw[i].powi(2) + self.noise_var[i]).sqrt()).collect());
         }
         if !p.values.is_empty() {
             self.pending.push_back(p);
@@ -569,6 +634,14 @@ impl ModelError {
                     let e2 = (xi - p.values[j][i]).powi(2);
                     let explained = p.unknown_var[j][i] + self.noise_var[i];
                     self.excess[j][i] += w * (e2 - explained - self.excess[j][i]);
+                    let band = p.raw_sigma[j][i];
+                    if band > 0.0 && band.is_finite() {
+                        let z = &mut self.normalized[j][i];
+                        z.push_back(e2.sqrt() / band);
+                        if z.len() > CHECK_MEMORY as usize {
+                            z.pop_front();
+                        }
+                    }
                 }
                 if j == 0 {
                     self.samples += 1;
@@ -693,6 +766,45 @@ mod tests {
         }
         // not the prior's 0.1 of the model's 1e-3
         assert!((c.at(0, 10.0, 1e-6) - 3e-4).abs() < 1e-5);
+    }
+
+    #[test]
+    fn the_band_is_scaled_to_cover_nine_checks_in_ten() {
+        // forecasts of 0 with a band of 1 (all of it unknown waves: no model error to learn); the
+        // errors then cycle through 0.3, 0.6 ... 3.0: heavier-tailed than a normal of that spread,
+        // nine in ten within 2.7, so the 90 % band must be 2.7 wide: a scale of 2.7 / 1.645
+        let mut m = ModelError::new(0.0, vec![0.0]);
+        let prior = ModelErrorCurve::prior(0.0, 1);
+        let (dt, n) = (0.5, 61);
+        let values = vec![0.0; n];
+        let sigma = vec![1.0; n];
+        let truth = |t: f64| {
+            let k = t.round() as i64;
+            0.3 * (k.rem_euclid(10) + 1) as f64 * if k % 2 == 0 { 1.0 } else { -1.0 }
+        };
+        for j in 0..700 {
+            let t = j as f64;
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior);
+            m.observe(t, |at| Some(vec![truth(at)]));
+        }
+        let c = m.curve();
+        let expect = 2.7 / Z90;
+        for j in 0..5 {
+            assert!((c.scale[0][j] - expect).abs() < 1e-9, "{:?}", c.scale);
+        }
+        assert!((c.scale_at(0, 7.5) - expect).abs() < 1e-9);
+        // a forecast made with it: its band is the scaled one, and a forecast recorded with that
+        // band teaches the same scale (no feedback)
+        let scaled: Vec<f64> = sigma.iter().map(|s| s * expect).collect();
+        let mut again = ModelError::new(0.0, vec![0.0]);
+        for j in 0..700 {
+            let t = j as f64;
+            again.record(t, dt, (&values, &scaled), &[1.0], &c);
+            again.observe(t, |at| Some(vec![truth(at)]));
+        }
+        assert!((again.curve().scale[0][2] - expect).abs() < 1e-9);
+        // not learnt: 1
+        assert_eq!(prior.scale_at(0, 30.0), 1.0);
     }
 
     #[test]
