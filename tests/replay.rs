@@ -1,7 +1,7 @@
 //! Recorded logs and replay (issue 7): a simulated log read by an off-the-shelf reader in Python,
 //! replayed through the daemon's engine deterministically, skill against lead time, damaged logs.
 
-use crate::util::{absolute_truth, repo, scratch_dir, shipcast, simulate_to};
+use crate::util::{absolute_paths, repo, scratch_dir, shipcast, simulate_to};
 use std::path::{Path, PathBuf};
 
 /// The simulated logs' data clock at the start (2025-06-15 UTC): fixed, so logs are reproducible.
@@ -10,15 +10,14 @@ const START_UNIX_S: f64 = 1_750_000_000.0;
 /// The README's skill-report config (`config/one-ship.toml`), copied into `dir` with its system path
 /// made absolute and the data clock's start fixed.
 fn config(dir: &Path) -> PathBuf {
-    let text = absolute_truth(&std::fs::read_to_string(repo("config/one-ship.toml")).unwrap())
-        .replace(
-            "file = \"vessels/ship/system.toml\"",
-            &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
-        )
-        .replace(
-            "[simulate]\n",
-            &format!("[simulate]\nstart_unix_s = {START_UNIX_S:?}\n"),
-        );
+    let text = absolute_paths(
+        &std::fs::read_to_string(repo("config/one-ship.toml")).unwrap(),
+        "vessels/ship/system.toml",
+    )
+    .replace(
+        "[simulate]\n",
+        &format!("[simulate]\nstart_unix_s = {START_UNIX_S:?}\n"),
+    );
     assert!(text.contains("start_unix_s"));
     assert!(text.contains(&*repo("config/vessels").to_string_lossy()));
     let p = dir.join("shipcast.toml");

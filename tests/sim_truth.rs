@@ -2,7 +2,7 @@
 //! another BEM database of the hull with quadratic roll damping (`config/vessels/ship/truth`), and its
 //! radar and IMU are not perfect. Checked through `shipcast simulate --truth`, as a user would.
 
-use crate::util::{absolute_truth, repo, scratch_dir, shipcast};
+use crate::util::{absolute_paths, repo, scratch_dir, simulate_to_with};
 use std::path::Path;
 
 /// Seconds simulated: several roll periods (14.8 s) after the 30 s ramp.
@@ -20,28 +20,16 @@ const MIN_HEAVE_CORRELATION: f64 = 0.9;
 /// `simulate --truth CSV` of `config/one-ship.toml` (beam seas, so that the ship rolls) with its text
 /// edited by `edit`; the CSV's columns by name.
 fn truth(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> Vec<(String, Vec<f64>)> {
-    let text = absolute_truth(&std::fs::read_to_string(repo("config/one-ship.toml")).unwrap())
-        .replace(
-            "file = \"vessels/ship/system.toml\"",
-            &format!("file = \"{}\"", repo("config/vessels/ship/system.toml").display()),
-        )
-        .replace("towards_deg = 270.0", &format!("towards_deg = 0.0\nhs_m = {HS_M:?}"));
+    let text = absolute_paths(
+        &std::fs::read_to_string(repo("config/one-ship.toml")).unwrap(),
+        "vessels/ship/system.toml",
+    )
+    .replace("towards_deg = 270.0", &format!("towards_deg = 0.0\nhs_m = {HS_M:?}"));
     let cfg = dir.join(format!("{name}.toml"));
     std::fs::write(&cfg, edit(text)).unwrap();
     let csv = dir.join(format!("{name}.csv"));
     let log = dir.join(format!("{name}.mcap"));
-    let (ok, _, err) = shipcast(&[
-        "simulate",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--record",
-        log.to_str().unwrap(),
-        "--truth",
-        csv.to_str().unwrap(),
-        "--duration",
-        &SIM_S.to_string(),
-    ]);
-    assert!(ok, "{err}");
+    simulate_to_with(&cfg, &log, SIM_S, &["--truth", csv.to_str().unwrap()]);
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();

@@ -27,12 +27,7 @@ pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: 
         assert_eq!(text.matches(from).count(), 1, "config/{config}: {from:?} once");
         text = text.replace(from, to);
     }
-    let file = format!("file = \"{system}\"");
-    assert!(text.contains(&file), "config/{config} does not say {file}");
-    let text = absolute_truth(&text.replace(
-        &file,
-        &format!("file = \"{}\"", repo(&format!("config/{system}")).display()),
-    ));
+    let text = absolute_paths(&text, system);
     let cfg_path = dir.join("shipcast.toml");
     std::fs::write(&cfg_path, text).unwrap();
     let path = dir.join("sim.mcap");
@@ -73,10 +68,16 @@ pub const ONE_SHIP_TWIN_SEA: [(&str, &str); 3] = [
     ),
 ];
 
-/// A shipped config's text with its `[simulate] truth_system` (relative to `config/`) made absolute,
-/// for a copy elsewhere.
-pub fn absolute_truth(text: &str) -> String {
+/// A shipped config's text with its `[system] file` (which must be `system`, relative to `config/`)
+/// and its `[simulate] truth_system` made absolute, for a copy elsewhere.
+pub fn absolute_paths(text: &str, system: &str) -> String {
+    let file = format!("file = \"{system}\"");
+    assert!(text.contains(&file), "the config does not say {file}");
     text.replace(
+        &file,
+        &format!("file = \"{}\"", repo(&format!("config/{system}")).display()),
+    )
+    .replace(
         "truth_system = \"vessels/",
         &format!("truth_system = \"{}/", repo("config/vessels").display()),
     )
@@ -84,15 +85,23 @@ pub fn absolute_truth(text: &str) -> String {
 
 /// `shipcast simulate --config CFG --record LOG --duration SECS`, which must succeed.
 pub fn simulate_to(cfg: &Path, log: &Path, secs: f64) {
-    let (ok, _, err) = shipcast(&[
+    simulate_to_with(cfg, log, secs, &[]);
+}
+
+/// [`simulate_to`] with `extra` arguments (`--truth CSV`).
+pub fn simulate_to_with(cfg: &Path, log: &Path, secs: f64, extra: &[&str]) {
+    let secs = secs.to_string();
+    let mut args = vec![
         "simulate",
         "--config",
         cfg.to_str().unwrap(),
         "--record",
         log.to_str().unwrap(),
         "--duration",
-        &secs.to_string(),
-    ]);
+        &secs,
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = shipcast(&args);
     assert!(ok, "{err}");
 }
 

@@ -432,39 +432,13 @@ impl ModelErrorCurve {
     fn learnt_at(&self, i: usize, lead_s: f64, model_motion_var: f64) -> f64 {
         let grown = self.prior * (lead_s / PRIOR_LEAD_S).max(1.0);
         let prior = grown * grown * model_motion_var;
-        let Some(f) = self.var.get(i) else {
-            return prior;
-        };
-        let v = |j: usize| f.get(j).copied().filter(|x| x.is_finite()).unwrap_or(prior);
-        let l = &self.lead_s;
-        let j = l.partition_point(|x| *x <= lead_s);
-        if j == 0 {
-            return v(0);
-        }
-        if j >= l.len() {
-            return v(l.len() - 1);
-        }
-        let a = (lead_s - l[j - 1]) / (l[j] - l[j - 1]);
-        v(j - 1) + a * (v(j) - v(j - 1))
+        along_leads(&self.lead_s, self.var.get(i), lead_s, prior)
     }
 
     /// Series i's band scale at `lead_s`: linear between the check leads, constant beyond them, 1 where
     /// not learnt.
     pub fn scale_at(&self, i: usize, lead_s: f64) -> f64 {
-        let Some(f) = self.scale.get(i) else {
-            return 1.0;
-        };
-        let v = |j: usize| f.get(j).copied().filter(|x| x.is_finite()).unwrap_or(1.0);
-        let l = &self.lead_s;
-        let j = l.partition_point(|x| *x <= lead_s);
-        if j == 0 || l.len() < 2 {
-            return v(0);
-        }
-        if j >= l.len() {
-            return v(l.len() - 1);
-        }
-        let a = (lead_s - l[j - 1]) / (l[j] - l[j - 1]);
-        v(j - 1) + a * (v(j) - v(j - 1))
+        along_leads(&self.lead_s, self.scale.get(i), lead_s, 1.0)
     }
 
     /// Series i's motion standard deviation: measured, else the model's.
@@ -474,6 +448,24 @@ impl ModelErrorCurve {
             .filter(|v| v.is_finite())
             .map_or(model_sigma, |v| v.sqrt())
     }
+}
+
+/// A learnt curve (`values` at each of `leads_s`, NaN or missing: `fallback`) at `lead_s`: linear
+/// between the leads, constant beyond them.
+fn along_leads(leads_s: &[f64], values: Option<&Vec<f64>>, lead_s: f64, fallback: f64) -> f64 {
+    let Some(f) = values else {
+        return fallback;
+    };
+    let v = |j: usize| f.get(j).copied().filter(|x| x.is_finite()).unwrap_or(fallback);
+    let j = leads_s.partition_point(|x| *x <= lead_s);
+    if j == 0 {
+        return v(0);
+    }
+    if j >= leads_s.len() {
+        return v(leads_s.len() - 1);
+    }
+    let a = (lead_s - leads_s[j - 1]) / (leads_s[j] - leads_s[j - 1]);
+    v(j - 1) + a * (v(j) - v(j - 1))
 }
 
 impl ModelError {
@@ -530,10 +522,10 @@ impl ModelError {
                         if z.len() < CHECK_MIN {
                             return f64::NAN;
                         }
-                        let mut sorted: Vec<f64> = z.iter().copied().collect();
-                        sorted.sort_by(f64::total_cmp);
-                        let q =
-                            sorted[((BAND_QUANTILE * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
+                        // the BAND_QUANTILE order statistic (a selection, not a sort: once per forecast)
+                        let mut z: Vec<f64> = z.iter().copied().collect();
+                        let k = ((BAND_QUANTILE * z.len() as f64).ceil() as usize).clamp(1, z.len()) - 1;
+                        let q = *z.select_nth_unstable_by(k, f64::total_cmp).1;
                         (q / Z90).clamp(BAND_SCALE_LIMITS.0, BAND_SCALE_LIMITS.1)
                     })
                     .collect()

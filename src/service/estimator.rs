@@ -248,11 +248,32 @@ pub struct Resampled {
     pub known: usize,
 }
 
-/// Running mean of a restored DOF's displacement: the bias.
+/// A running mean of 6 DOFs over the last `tau_s` of what it was given (over all of it until then):
+/// each value counts for the time since the one before. The estimator's bias; the engine's mean of
+/// its model's own forecasts.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Bias {
-    value: [f64; 6],
-    span_s: f64,
+pub struct RunningMean {
+    pub value: [f64; 6],
+    /// The time the mean has been taken over, s.
+    pub span_s: f64,
+}
+
+impl RunningMean {
+    /// Takes in `x`, counting for `dt_s` (the first value: all of the mean); non-finite DOFs are left
+    /// as they were.
+    pub fn add(&mut self, dt_s: f64, x: &[f64; 6], tau_s: f64) {
+        self.span_s += dt_s;
+        let w = if self.span_s <= 0.0 {
+            1.0
+        } else {
+            (dt_s / tau_s.min(self.span_s)).min(1.0)
+        };
+        for (m, xd) in self.value.iter_mut().zip(x) {
+            if xd.is_finite() {
+                *m += w * (xd - *m);
+            }
+        }
+    }
 }
 
 /// A vessel's estimator: the kept window of filtered samples, the bias, and a run of refused samples
@@ -262,7 +283,7 @@ pub struct Estimator {
     spec: Spec,
     keep_s: f64,
     entries: VecDeque<Entry>,
-    bias: Bias,
+    bias: RunningMean,
     /// Refused samples in a row that agree with each other, filtered from the first of them.
     candidate: Vec<Entry>,
     /// The values of the last sample received (taken or not), and how many received in a row
@@ -281,7 +302,7 @@ impl Estimator {
             spec,
             keep_s,
             entries: VecDeque::new(),
-            bias: Bias::default(),
+            bias: RunningMean::default(),
             candidate: vec![],
             last_received: None,
             repeats: 0,
@@ -469,7 +490,7 @@ impl Estimator {
             return Err(why);
         }
         self.entries.clear();
-        self.bias = Bias::default();
+        self.bias = RunningMean::default();
         for e in std::mem::take(&mut self.candidate) {
             self.take(e);
         }
@@ -477,19 +498,16 @@ impl Estimator {
     }
 
     fn take(&mut self, e: Entry) {
-        if let Some(prev) = self.entries.back() {
-            self.moved |= prev.x != e.x || prev.v != e.v;
-            // a sample after a gap counts for a second at most: one reading does not stand for the
-            // whole silence
-            let dt = (e.time_s - prev.time_s).min(BIAS_MAX_INTERVAL_S);
-            self.bias.span_s += dt;
-            let w = (dt / self.spec.bias_time_s.min(self.bias.span_s)).min(1.0);
-            for d in 0..6 {
-                self.bias.value[d] += w * (e.x[d] - self.bias.value[d]);
+        // a sample after a gap counts for a second at most: one reading does not stand for the whole
+        // silence; the first after a restart of the samples, for nothing (the bias is the sensor's)
+        let dt = match self.entries.back() {
+            Some(prev) => {
+                self.moved |= prev.x != e.x || prev.v != e.v;
+                (e.time_s - prev.time_s).min(BIAS_MAX_INTERVAL_S)
             }
-        } else if self.bias.span_s == 0.0 {
-            self.bias.value = e.x;
-        }
+            None => 0.0,
+        };
+        self.bias.add(dt, &e.x, self.spec.bias_time_s);
         let t = e.time_s;
         self.entries.push_back(e);
         while let Some(f) = self.entries.front() {

@@ -626,11 +626,10 @@ pub struct Engine {
     /// at 30 s when it was last logged.
     model_error: spread::ModelError,
     model_error_logged: usize,
-    /// The model's own mean displacement in waves per vessel and DOF (heave, roll, pitch), and when
-    /// and over how long it was learnt (`learn_model_mean`).
-    model_mean: Vec<[f64; 6]>,
+    /// The model's own mean displacement in waves per vessel and DOF (heave, roll, pitch), and when it
+    /// was last learnt (`learn_model_mean`).
+    model_mean: Vec<estimator::RunningMean>,
     model_mean_time_s: Option<f64>,
-    model_mean_span_s: f64,
     bias_time_s: f64,
 }
 
@@ -692,9 +691,8 @@ impl Engine {
             last_horizon: [0.0; MAX_VESSELS],
             state_flags: 0,
             model_error_logged: 0,
-            model_mean: vec![[0.0; 6]; n_bodies],
+            model_mean: vec![Default::default(); n_bodies],
             model_mean_time_s: None,
-            model_mean_span_s: 0.0,
             bias_time_s: cfg.estimator.bias_time_s,
             model_error: spread::ModelError::new(
                 cfg.forecast.model_error,
@@ -970,7 +968,12 @@ impl Engine {
                 for (row, &i) in self.active.iter().enumerate() {
                     if i / 6 == b && i < 6 * n_bodies {
                         let d = i % 6;
-                        x0[row] = r.x0[d] + if bias[d] != 0.0 { self.model_mean[b][d] } else { 0.0 };
+                        x0[row] = r.x0[d]
+                            + if bias[d] != 0.0 {
+                                self.model_mean[b].value[d]
+                            } else {
+                                0.0
+                            };
                         v0[row] = r.v0[i % 6];
                         for (m, v) in r.velocities.iter().enumerate() {
                             velocities[m][row] = v[i % 6];
@@ -1179,21 +1182,14 @@ impl Engine {
             None => 0.0,
         };
         self.model_mean_time_s = Some(header.issue_time_s);
-        self.model_mean_span_s += dt;
-        let w = if self.model_mean_span_s <= 0.0 {
-            1.0
-        } else {
-            (dt / self.bias_time_s.min(self.model_mean_span_s)).min(1.0)
-        };
-        for b in 0..self.n_bodies {
+        for (b, m) in self.model_mean.iter_mut().enumerate() {
+            // heave, roll and pitch (the DOFs with a bias); the others stay 0
+            let mut mean = [f64::NAN; 6];
             for d in 2..5 {
-                let series = &values[(6 * b + d) * (steps + 1)..(6 * b + d + 1) * (steps + 1)];
-                let mean = series[first..].iter().sum::<f64>() / (steps + 1 - first) as f64;
-                if mean.is_finite() {
-                    let m = &mut self.model_mean[b][d];
-                    *m += w * (mean - *m);
-                }
+                let series = &values[(6 * b + d) * (steps + 1) + first..(6 * b + d + 1) * (steps + 1)];
+                mean[d] = series.iter().sum::<f64>() / series.len() as f64;
             }
+            m.add(dt, &mean, self.bias_time_s);
         }
     }
 
