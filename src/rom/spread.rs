@@ -264,10 +264,12 @@ pub fn spread(
             let floor = opts.model_error.at(i, lead_s, total[i]);
             acc += dk;
             rate += dr;
-            let scaled = ((acc + rate * k as f64).max(0.0) + floor).sqrt() * opts.model_error.scale_at(i, lead_s);
+            let scale = opts.model_error.scale_at(i, lead_s);
+            let noise_var = opts.model_error.noise_var.get(i).copied().unwrap_or(0.0);
+            let start = start_var(noise_var, lead_s);
+            let scaled = (((acc + rate * k as f64).max(0.0) + floor) * scale * scale + start).sqrt();
             // never narrower than the sensor's noise
-            let noise = opts.model_error.noise_var.get(i).copied().unwrap_or(0.0).sqrt();
-            sigma.push(scaled.max(noise));
+            sigma.push(scaled.max(noise_var.sqrt()));
         }
     }
     let motion_sigma: Vec<f64> = total.iter().map(|t| t.sqrt()).collect();
@@ -450,6 +452,13 @@ impl ModelErrorCurve {
     }
 }
 
+/// The variance the estimate a forecast starts from adds to its band at `lead_s`: it errs by up to
+/// the sensor's noise, which the checks at lead 0 (against that same estimate) do not see; fading
+/// into the first later check lead, whose checks hold it.
+fn start_var(noise_var: f64, lead_s: f64) -> f64 {
+    noise_var * (1.0 - lead_s / CHECK_LEADS_S[1]).max(0.0)
+}
+
 /// A learnt curve (`values` at each of `leads_s`, NaN or missing: `fallback`) at `lead_s`: linear
 /// between the leads, constant beyond them.
 fn along_leads(leads_s: &[f64], values: Option<&Vec<f64>>, lead_s: f64, fallback: f64) -> f64 {
@@ -541,6 +550,12 @@ impl ModelError {
         }
     }
 
+    /// The sensor's noise variance between series i's forecast at `lead_s` and its check: none at
+    /// lead 0, where the check is the estimate the forecast started from (`observe` says the same).
+    fn check_noise_var(&self, i: usize, lead_s: f64) -> f64 {
+        if lead_s > 0.0 { self.noise_var[i] } else { 0.0 }
+    }
+
     /// Series i's measured motion variance, less the sensor's noise (NaN before [`CHECK_MIN`], or
     /// when it is below [`MIN_SIGNAL_TO_NOISE`] times the noise).
     fn motion_var(&self, i: usize) -> f64 {
@@ -586,8 +601,14 @@ impl ModelError {
                 break;
             }
             p.values.push((0..ns).map(|i| values[i * n + k]).collect());
-            // the band as published is the unscaled one times the scale it was made with
-            let raw: Vec<f64> = (0..ns).map(|i| sigma[i * n + k] / used.scale_at(i, lead)).collect();
+            // the band as published is the unscaled one times the scale it was made with, and the
+            // start's error (at most: a band at the noise's floor is taken as its whole)
+            let raw: Vec<f64> = (0..ns)
+                .map(|i| {
+                    let start = start_var(self.noise_var[i], lead);
+                    (sigma[i * n + k].powi(2) - start).max(0.0).sqrt() / used.scale_at(i, lead)
+                })
+                .collect();
             p.unknown_var.push(
                 (0..ns)
                     .map(|i| {
@@ -596,8 +617,11 @@ impl ModelError {
                     })
                     .collect(),
             );
-            p.raw_sigma
-                .push((0..ns).map(|i| (raw[i].powi(2) + self.noise_var[i]).sqrt()).collect());
+            p.raw_sigma.push(
+                (0..ns)
+                    .map(|i| (raw[i].powi(2) + self.check_noise_var(i, lead)).sqrt())
+                    .collect(),
+            );
         }
         if !p.values.is_empty() {
             self.pending.push_back(p);
@@ -624,7 +648,8 @@ impl ModelError {
                 let w = 1.0 / (self.checks[j] as f64).min(CHECK_MEMORY);
                 for (i, xi) in x.iter().enumerate() {
                     let e2 = (xi - p.values[j][i]).powi(2);
-                    let explained = p.unknown_var[j][i] + self.noise_var[i];
+                    let noise = if CHECK_LEADS_S[j] > 0.0 { self.noise_var[i] } else { 0.0 };
+                    let explained = p.unknown_var[j][i] + noise;
                     self.excess[j][i] += w * (e2 - explained - self.excess[j][i]);
                     let band = p.raw_sigma[j][i];
                     if band > 0.0 && band.is_finite() {
@@ -753,11 +778,33 @@ mod tests {
         }
         let c = m.curve();
         assert!(c.motion_var[0].is_nan(), "buried in the noise: not the span's judge");
-        for j in 0..4 {
+        // lead 0's check is the estimate the forecast started from: no noise between them
+        assert!((c.var[0][0] - 4e-4).abs() < 1e-5, "{:?}", c.var);
+        for j in 1..4 {
             assert!((c.var[0][j] - 3e-4).abs() < 1e-5, "{:?}", c.var);
         }
         // not the prior's 0.1 of the model's 1e-3
         assert!((c.at(0, 10.0, 1e-6) - 3e-4).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_check_at_lead_0_has_no_sensor_noise_to_explain_it() {
+        // a forecast starts from the estimate it is checked against at lead 0: an offset between the
+        // two (a heel the model does not know) is all model error, whatever the sensor's noise
+        let mut m = ModelError::new(0.0, vec![1e-6]);
+        let prior = ModelErrorCurve::prior(0.0, 1);
+        let (dt, n) = (0.5, 61);
+        let values = vec![0.002; n];
+        let sigma = vec![0.0; n];
+        for j in 0..100 {
+            let t = j as f64;
+            m.record(t, dt, (&values, &sigma), &[1e-2], &prior);
+            m.observe(t, |_| Some(vec![0.0]));
+        }
+        let c = m.curve();
+        assert!((c.var[0][0] - 4e-6).abs() < 1e-12, "{:?}", c.var);
+        // later leads are checked against an estimate the noise has moved since
+        assert!((c.var[0][1] - 3e-6).abs() < 1e-12, "{:?}", c.var);
     }
 
     #[test]

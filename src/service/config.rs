@@ -188,6 +188,10 @@ pub struct EstimatorConfig {
     pub reset_samples: u32,
     /// Time constant of the bias average (heave, roll, pitch), s.
     pub bias_time_s: f64,
+    /// The largest bias the motion sensor's roll and pitch may have (installation misalignment and
+    /// drift), rad: a measured mean heel or trim beyond the model's own by more is real, and the
+    /// forecast keeps it less this.
+    pub angle_bias_rad: f64,
 }
 
 impl Default for EstimatorConfig {
@@ -202,6 +206,7 @@ impl Default for EstimatorConfig {
             gate_sigma: 5.0,
             reset_samples: 5,
             bias_time_s: 300.0,
+            angle_bias_rad: 0.001,
         }
     }
 }
@@ -774,6 +779,7 @@ pub const BOUNDS: &[Bound] = &[
     // refused samples in a row before a jump is believed: a few seconds of motion at 1000 Hz
     closed("estimator.reset_samples", 1.0, 1000.0, ""),
     positive("estimator.bias_time_s", DAY_S, "s"),
+    closed("estimator.angle_bias_rad", 0.0, 0.1, "rad"),
     // a terabyte of messages per file at most
     positive("record.rotate_mb", 1.0e6, "MB"),
     positive("record.rotate_s", 30.0 * DAY_S, "s"),
@@ -878,6 +884,7 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("estimator.gate_sigma", c.estimator.gate_sigma),
         one("estimator.reset_samples", c.estimator.reset_samples as f64),
         one("estimator.bias_time_s", c.estimator.bias_time_s),
+        one("estimator.angle_bias_rad", c.estimator.angle_bias_rad),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
         one("simulate.duration_s", s.duration_s),

@@ -31,9 +31,11 @@
 //!   each sample counting for the time since the one before, at most `BIAS_MAX_INTERVAL_S`) is
 //!   the sensor's bias (or a static heel or trim: the two cannot be told apart from the motion alone;
 //!   the status reports the estimate). It is taken off the initial displacement once it has averaged
-//!   over a fifth of that time (the engine puts the model's own mean in waves back on: a moored
-//!   vessel's heel from its lines and fenders, `Engine::learn_model_mean`). The velocity history is not affected by a constant bias. DOFs without
-//!   restoring have no observable bias.
+//!   over a fifth of that time: the model starts from its own mean in waves (a moored vessel's heel
+//!   from its lines and fenders, `Engine::learn_model_mean`), and its forecast of roll and pitch is
+//!   shifted back to the measured mean (a heel the model does not know is kept;
+//!   `MEASURED_MEAN_DOFS`). The velocity history is not affected by
+//!   a constant bias. DOFs without restoring have no observable bias.
 
 use std::collections::VecDeque;
 

@@ -146,6 +146,18 @@ pub struct Done {
     pub teaches: bool,
 }
 
+/// The DOFs (roll, pitch) whose forecast keeps the measured mean (the estimator's bias) where it is
+/// further from the model's own mean in waves than the sensor's bias can be
+/// (`estimator.angle_bias_rad`): a motion sensor's angles are gravity-referenced, so their long mean
+/// is a real heel or trim (its bias an installation misalignment of hundredths of a degree), which
+/// the model may not know; its heave is integrated acceleration, whose long mean is drift.
+pub const MEASURED_MEAN_DOFS: [usize; 2] = [3, 4];
+
+/// What of `x` lies beyond +-`bound` (0 within it).
+fn beyond(x: f64, bound: f64) -> f64 {
+    x.signum() * (x.abs() - bound).max(0.0)
+}
+
 /// A forecast's leads from this one on are settled (past a roll's decay, 1 / (zeta w_n) = 47 s at 5 %
 /// of critical and 0.43 rad/s): their mean is the model's own mean in waves, s.
 pub const SETTLED_LEAD_S: f64 = 60.0;
@@ -631,6 +643,12 @@ pub struct Engine {
     model_mean: Vec<estimator::RunningMean>,
     model_mean_time_s: Option<f64>,
     bias_time_s: f64,
+    /// `estimator.angle_bias_rad`.
+    angle_bias_rad: f64,
+    /// Per vessel and DOF, what the running job's forecast is shifted by when done: for
+    /// [`MEASURED_MEAN_DOFS`], the measured mean (the estimator's bias) less the model's own (the
+    /// model forecasts the motion about its mean, the mean is as measured).
+    job_offset: Vec<[f64; 6]>,
 }
 
 impl Engine {
@@ -693,7 +711,9 @@ impl Engine {
             model_error_logged: 0,
             model_mean: vec![Default::default(); n_bodies],
             model_mean_time_s: None,
+            job_offset: vec![[0.0; 6]; n_bodies],
             bias_time_s: cfg.estimator.bias_time_s,
+            angle_bias_rad: cfg.estimator.angle_bias_rad,
             model_error: spread::ModelError::new(
                 cfg.forecast.model_error,
                 // the motion sensor's noise as the estimator is told it (translations, rotations)
@@ -949,6 +969,7 @@ impl Engine {
             let mut v0 = vec![0.0; self.n_active];
             let mut velocities = vec![vec![0.0; self.n_active]; n_hist];
             let mut known_history = n_hist;
+            let mut offset = vec![[0.0; 6]; n_bodies];
             let mut ok = true;
             for b in 0..n_bodies {
                 let Some(r) = self.hist[b].resample(t0, dt, n_hist, cfg.max_gap_s) else {
@@ -962,12 +983,18 @@ impl Engine {
                     fl |= flags::HISTORY_GAP;
                 }
                 known_history = known_history.min(r.known);
-                // the estimator takes its bias off (the sensor's and a mean heel alike); the
-                // model's own mean in waves goes back on
+                // the estimator takes its bias off (the sensor's and a mean heel alike); the model
+                // starts from its own mean in waves, and the forecast of roll and pitch is shifted
+                // toward the measured mean when done: beyond what the sensor's bias can be, a heel or
+                // trim the model does not know (angles are gravity-referenced; heave is integrated
+                // acceleration, whose mean is drift: heave keeps the model's)
                 let bias = self.hist[b].bias();
                 for (row, &i) in self.active.iter().enumerate() {
                     if i / 6 == b && i < 6 * n_bodies {
                         let d = i % 6;
+                        if bias[d] != 0.0 && MEASURED_MEAN_DOFS.contains(&d) {
+                            offset[b][d] = beyond(bias[d] - self.model_mean[b].value[d], self.angle_bias_rad);
+                        }
                         x0[row] = r.x0[d]
                             + if bias[d] != 0.0 {
                                 self.model_mean[b].value[d]
@@ -1103,6 +1130,7 @@ impl Engine {
                     .collect();
                 fl = header.flags;
                 self.busy = true;
+                self.job_offset = offset;
                 job = Some(Job {
                     t0_s: t0,
                     x0,
@@ -1143,8 +1171,10 @@ impl Engine {
                 // untrusted field's error is its waves'), with or without a trusted span
                 let n = (header.steps as usize + 1) * header.n_series as usize;
                 let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share;
+                let mut values = values;
                 if values.len() == 2 * n {
                     self.learn_model_mean(&header, &values[..n]);
+                    self.shift_to_measured_mean(&header, &mut values[..n]);
                 }
                 if values.len() == 2 * n && trusted {
                     self.model_error.record(
@@ -1169,8 +1199,8 @@ impl Engine {
     /// The model's own mean displacement in waves (heave, roll, pitch), from a forecast's settled leads
     /// (at least [`SETTLED_LEAD_S`]): averaged over [`crate::service::config::EstimatorConfig`]'s
     /// `bias_time_s`, as the estimator averages the measured motion. Lines and fenders give a moored
-    /// vessel a mean heel in waves, which the estimator's bias also holds: the bias less this mean is
-    /// the sensor's.
+    /// vessel a mean heel in waves; the model starts from its own, and its forecast of roll and pitch
+    /// is shifted to the measured one ([`MEASURED_MEAN_DOFS`]).
     fn learn_model_mean(&mut self, header: &ForecastHeader, values: &[f64]) {
         let steps = header.steps as usize;
         let first = (SETTLED_LEAD_S / header.dt_s).ceil() as usize;
@@ -1190,6 +1220,23 @@ impl Engine {
                 mean[d] = series.iter().sum::<f64>() / series.len() as f64;
             }
             m.add(dt, &mean, self.bias_time_s);
+        }
+    }
+
+    /// Shifts a forecast's values (the model's motion about its own mean) by the job's offsets: the
+    /// measured mean less the model's, per vessel and DOF.
+    fn shift_to_measured_mean(&self, header: &ForecastHeader, values: &mut [f64]) {
+        let per = header.steps as usize + 1;
+        if values.len() != per * 6 * self.n_bodies {
+            return;
+        }
+        for (b, o) in self.job_offset.iter().enumerate().take(self.n_bodies) {
+            for (d, od) in o.iter().enumerate() {
+                if *od != 0.0 && od.is_finite() {
+                    let i = 6 * b + d;
+                    values[i * per..(i + 1) * per].iter_mut().for_each(|v| *v += od);
+                }
+            }
         }
     }
 
