@@ -12,6 +12,7 @@ pub mod console;
 pub mod files;
 pub mod hydro;
 pub mod ipc;
+pub mod link;
 pub mod operation;
 pub mod process;
 pub mod rao;

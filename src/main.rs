@@ -52,6 +52,9 @@ enum Command {
     Replay(cli::replay::ReplayArgs),
     /// External CSV recordings (motion, wave probes) written as a log for `replay`.
     Import(cli::replay::ImportArgs),
+    /// The ship-to-ship link: this host's services bridged to the other ship's over Zenoh ([link];
+    /// built with `--features link`).
+    Link(cli::link::LinkArgs),
 }
 
 #[derive(Subcommand, Debug)]
@@ -92,6 +95,13 @@ fn main() -> ExitCode {
             }
             Err(e) => Some(Err(e)),
         },
+        Command::Link(a) => match cli::daemon::load_config(&a.config) {
+            Ok(cfg) => {
+                init_logging(&cfg.log.level, cfg.log.format == "json");
+                Some(cli::link::run(cfg))
+            }
+            Err(e) => Some(Err(e)),
+        },
         // a full-screen view: logs would tear it
         Command::Console(a) => Some(cli::console::run(a)),
         Command::Simulate(_) | Command::Watch(_) | Command::Demo(_) => {
@@ -129,7 +139,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Simulate(args) => cli::daemon::simulate(&args),
         Command::Watch(args) => cli::daemon::watch(&args),
         Command::Demo(args) => cli::daemon::demo(&args),
-        Command::Console(_) => Ok(()),
+        Command::Console(_) | Command::Link(_) => Ok(()),
         Command::Replay(args) => cli::replay::run(&args),
         Command::Import(args) => cli::replay::import(&args),
     }

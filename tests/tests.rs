@@ -18,6 +18,8 @@ mod external_models;
 mod forecast_cli;
 mod indep_barge_probe;
 mod kramers_kronig;
+#[cfg(feature = "link")]
+mod link;
 mod replay;
 mod rom;
 mod sim_truth;

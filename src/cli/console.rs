@@ -107,6 +107,14 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                             overruns: s.overruns,
                             running: s.running != 0,
                             received_wall_s: now,
+                            link: (s.link_state != shipcast::ipc::wire::link_state::NONE).then_some(
+                                shipcast::console::LinkHealth {
+                                    up: s.link_state == shipcast::ipc::wire::link_state::UP,
+                                    latency_ms: s.link_latency_ms,
+                                    loss: s.link_loss,
+                                    age_s: s.link_age_s,
+                                },
+                            ),
                         })
                     }
                 };

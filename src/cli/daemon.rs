@@ -39,6 +39,10 @@ pub struct SimulateArgs {
     /// Simulated duration, s (default: simulate.duration_s).
     #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
+    /// With --publish: publish this vessel's motion and navigation under another iceoryx2 prefix,
+    /// VESSEL=PREFIX (the other ship's host, to try `shipcast link` on one machine); repeatable.
+    #[arg(long = "vessel-prefix", value_name = "VESSEL=PREFIX", requires = "publish")]
+    vessel_prefix: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -192,6 +196,24 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     } else {
         None
     };
+    let mut elsewhere: Vec<(u32, SensorPublisher)> = vec![];
+    for vp in &a.vessel_prefix {
+        let (v, prefix) = vp
+            .split_once('=')
+            .and_then(|(v, p)| Some((v.trim().parse::<u32>().ok()?, p.trim())))
+            .filter(|(v, p)| (*v as usize) < n_bodies && !p.is_empty())
+            .ok_or_else(|| anyhow::anyhow!("--vessel-prefix {vp:?}: VESSEL=PREFIX, a vessel 0..{n_bodies}"))?;
+        let p = SensorPublisher::new(&Names { prefix: prefix.into() })
+            .map_err(|e| anyhow::anyhow!("iceoryx2 (--vessel-prefix {vp}): {e}"))?;
+        elsewhere.push((v, p));
+    }
+    let publisher_of = |vessel: u32| -> Option<&SensorPublisher> {
+        elsewhere
+            .iter()
+            .find(|(v, _)| *v == vessel)
+            .map(|(_, p)| p)
+            .or(publisher.as_ref())
+    };
     // the data clock: UNIX seconds at the start (simulate.start_unix_s, default the wall clock), then
     // simulation time; published and recorded stamps and log times are on it
     let epoch = cfg.simulate.start_unix_s.unwrap_or_else(service::wall_s);
@@ -236,7 +258,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         if next_nav <= next_imu && next_nav <= next_radar {
             for fix in sim.navigation(t) {
                 let n = shipcast::service::navigation::to_wire(fix.vessel as u32, t + epoch, &fix);
-                if let Some(p) = &publisher {
+                if let Some(p) = publisher_of(n.vessel) {
                     let due = Duration::from_secs_f64(t / speed);
                     if let Some(wait) = due.checked_sub(start.elapsed()) {
                         std::thread::sleep(wait);
@@ -272,7 +294,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
             }
             for mut s in sim.imu(t) {
                 s.time_s += epoch;
-                p.motion(&to_wire(&s))
+                let m = to_wire(&s);
+                publisher_of(m.vessel)
+                    .unwrap_or(p)
+                    .motion(&m)
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
         } else if let Some(rec) = recorder.as_mut() {
@@ -381,7 +406,7 @@ fn scan_of(sim: &Simulation, epoch: f64) -> Option<shipcast::ipc::Scan> {
 }
 
 /// Sets `flag` on SIGINT/SIGTERM (the simulator is not async).
-fn ctrlc_flag(flag: Arc<AtomicBool>) -> std::io::Result<()> {
+pub(crate) fn ctrlc_flag(flag: Arc<AtomicBool>) -> std::io::Result<()> {
     std::thread::Builder::new().name("signals".into()).spawn(move || {
         let Ok(rt) = tokio::runtime::Builder::new_current_thread().enable_all().build() else {
             return;
@@ -527,6 +552,13 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
             "roll_deg": finite(b[1].to_degrees()),
             "pitch_deg": finite(b[2].to_degrees()),
         })).collect::<Vec<_>>(),
+        // the ship-to-ship link: null when none runs
+        "link": (s.link_state != shipcast::ipc::wire::link_state::NONE).then(|| serde_json::json!({
+            "up": s.link_state == shipcast::ipc::wire::link_state::UP,
+            "latency_ms": finite(s.link_latency_ms).as_f64().filter(|v| *v >= 0.0),
+            "loss": finite(s.link_loss).as_f64().filter(|v| *v >= 0.0),
+            "last_message_age_s": finite(s.link_age_s).as_f64().filter(|v| *v >= 0.0),
+        })),
         "flags": flags::names(s.flags),
     })
     .to_string()

@@ -5,6 +5,7 @@ pub mod console;
 pub mod daemon;
 pub mod forecast;
 pub mod horizon;
+pub mod link;
 pub mod plot;
 pub mod rao;
 pub mod replay;

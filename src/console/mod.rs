@@ -106,6 +106,20 @@ pub struct Health {
     /// False in the last status of a clean shutdown.
     pub running: bool,
     pub received_wall_s: f64,
+    /// The ship-to-ship link, when one runs.
+    pub link: Option<LinkHealth>,
+}
+
+/// The ship-to-ship link's health as the status reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkHealth {
+    pub up: bool,
+    /// Median latency, ms (negative: none measured).
+    pub latency_ms: f64,
+    /// Share of messages lost, 0..1 (negative: none heard of).
+    pub loss: f64,
+    /// Age of the newest message from the other ship, s (negative: none yet).
+    pub age_s: f64,
 }
 
 /// Keys the console understands (the shell maps the terminal's events to these).
@@ -559,6 +573,7 @@ mod tests {
             last_compute_ms: 10.0,
             overruns: 0,
             running: true,
+            link: None,
             received_wall_s: 5010.0,
         });
         assert_eq!(c.link(5010.5), Link::Live);

@@ -199,6 +199,29 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
                 (Severity::Ok, format!("{n} IMU: {a:.1} s old, {r:.0} Hz"))
             });
         }
+        if let Some(l) = &h.link {
+            let lat = if l.latency_ms >= 0.0 {
+                format!("{:.0} ms", l.latency_ms)
+            } else {
+                "-".into()
+            };
+            let loss = if l.loss >= 0.0 {
+                format!("{:.0} %", 100.0 * l.loss)
+            } else {
+                "-".into()
+            };
+            out.push(match (l.up, l.age_s) {
+                (true, a) => (
+                    Severity::Ok,
+                    format!("Link to the other ship: up, latency {lat}, loss {loss}, last {a:.1} s ago"),
+                ),
+                (false, a) if a < 0.0 => (Severity::Alarm, "Link to the other ship: nothing heard yet".into()),
+                (false, a) => (
+                    Severity::Alarm,
+                    format!("Link to the other ship: down, nothing for {a:.0} s (loss {loss})"),
+                ),
+            });
+        }
         if h.flags.contains(&"history_short") {
             out.push((
                 Severity::Caution,
@@ -541,6 +564,55 @@ mod tests {
             .map(|y| (0..w).map(|x| b[(x, y)].symbol()).collect::<String>())
             .collect::<Vec<_>>()
             .join("\n")
+    }
+
+    #[test]
+    fn the_ship_to_ship_link_is_shown_up_and_down() {
+        let mut c = two_vessels();
+        let health = |link| crate::console::Health {
+            flags: vec![],
+            wave_age_s: 1.0,
+            motion_age_s: vec![0.1, 0.1],
+            motion_rate_hz: vec![10.0, 10.0],
+            last_compute_ms: 10.0,
+            overruns: 0,
+            running: true,
+            link,
+            received_wall_s: 5000.0,
+        };
+        let link_line = |c: &Console| {
+            health_lines(c, 5000.0)
+                .into_iter()
+                .find(|(_, l)| l.starts_with("Link to"))
+        };
+        c.on_health(health(None));
+        assert_eq!(link_line(&c), None);
+        c.on_health(health(Some(crate::console::LinkHealth {
+            up: true,
+            latency_ms: 3.2,
+            loss: 0.01,
+            age_s: 0.06,
+        })));
+        assert_eq!(
+            link_line(&c),
+            Some((
+                Severity::Ok,
+                "Link to the other ship: up, latency 3 ms, loss 1 %, last 0.1 s ago".into()
+            ))
+        );
+        c.on_health(health(Some(crate::console::LinkHealth {
+            up: false,
+            latency_ms: -1.0,
+            loss: -1.0,
+            age_s: 21.4,
+        })));
+        assert_eq!(
+            link_line(&c),
+            Some((
+                Severity::Alarm,
+                "Link to the other ship: down, nothing for 21 s (loss -)".into()
+            ))
+        );
     }
 
     #[test]

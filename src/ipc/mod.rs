@@ -134,6 +134,15 @@ fn status_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedServi
         .map_err(err)
 }
 
+fn link_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService<LinkStatus>> {
+    node.service_builder(&names.name("link")?)
+        .publish_subscribe::<LinkStatus>()
+        .subscriber_max_buffer_size(8)
+        .history_size(1)
+        .open_or_create()
+        .map_err(err)
+}
+
 /// A wave field decoded from the wire.
 pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<WaveField, String> {
     if h.schema_version != SCHEMA_VERSION {
@@ -240,6 +249,8 @@ pub enum Input {
     /// A radar scan (boxed: a scan is up to 4 MB).
     Elevation(Box<Scan>),
     Waves(WaveField),
+    /// The ship-to-ship link's health (`shipcast link`).
+    Link(LinkStatus),
     /// A sample that could not be decoded (counted, logged).
     Rejected(String),
 }
@@ -278,9 +289,17 @@ pub fn spawn_input(
                     .create()
                     .map_err(err)?;
                 let (_, elev_l) = event(&node, &names, "elevation")?;
-                Ok((node, (motion, nav, waves, elev), (motion_l, nav_l, waves_l, elev_l)))
+                let link = link_service(&node, &names)?
+                    .subscriber_builder()
+                    .create()
+                    .map_err(err)?;
+                Ok((
+                    node,
+                    (motion, nav, waves, elev, link),
+                    (motion_l, nav_l, waves_l, elev_l),
+                ))
             };
-            let (node, (motion, nav, waves, elev), (motion_l, nav_l, waves_l, elev_l)) = match setup() {
+            let (node, (motion, nav, waves, elev, link), (motion_l, nav_l, waves_l, elev_l)) = match setup() {
                 Ok(s) => {
                     let _ = ready.send(Ok(()));
                     s
@@ -345,6 +364,12 @@ pub fn spawn_input(
                         return false;
                     }
                 }
+                // the link's health comes a second at a time: read at every wake (the interval's too)
+                while let Ok(Some(s)) = link.receive() {
+                    if tx.blocking_send(Input::Link(*s.payload())).is_err() {
+                        return false;
+                    }
+                }
                 true
             };
             // whatever was there before we attached (history of the waves service)
@@ -386,26 +411,10 @@ pub fn spawn_output(
     std::thread::Builder::new()
         .name("shipcast-ipc-out".into())
         .spawn(move || {
-            let setup = || -> Result<_> {
-                let node = node()?;
-                let fc = forecast_service(&node, &names)?
-                    .publisher_builder()
-                    .initial_max_slice_len(6 * MAX_VESSELS * 6001)
-                    .allocation_strategy(AllocationStrategy::PowerOfTwo)
-                    .create()
-                    .map_err(err)?;
-                let st = status_service(&node, &names)?
-                    .publisher_builder()
-                    .create()
-                    .map_err(err)?;
-                let (fc_n, _) = event(&node, &names, "forecast")?;
-                let (st_n, _) = event(&node, &names, "status")?;
-                Ok((node, fc, st, fc_n, st_n))
-            };
-            let (_node, fc, st, fc_n, st_n) = match setup() {
-                Ok(s) => {
+            let p = match OutputPublisher::new(&names) {
+                Ok(p) => {
                     let _ = ready.send(Ok(()));
-                    s
+                    p
                 }
                 Err(e) => {
                     let _ = ready.send(Err(e));
@@ -413,28 +422,181 @@ pub fn spawn_output(
                 }
             };
             while let Ok(out) = rx.recv() {
-                let r: Result<()> = (|| match out {
-                    Output::Forecast(h, values) => {
-                        let s = fc.loan_slice_uninit(values.len()).map_err(err)?;
-                        let mut s = s.write_from_slice(&values);
-                        *s.user_header_mut() = h;
-                        s.send().map_err(err)?;
-                        fc_n.notify().map_err(err)?;
-                        Ok(())
-                    }
-                    Output::Status(status) => {
-                        let s = st.loan_uninit().map_err(err)?;
-                        s.write_payload(status).send().map_err(err)?;
-                        st_n.notify().map_err(err)?;
-                        Ok(())
-                    }
-                })();
-                if let Err(e) = r {
+                if let Err(e) = p.publish(&out) {
                     tracing::warn!("publishing failed: {e}");
                 }
             }
         })
         .expect("spawning the output thread")
+}
+
+/// Publishers of forecasts and status: the daemon's output thread, and the link's for the other
+/// ship's daemon (under its own prefix). Blocking.
+pub struct OutputPublisher {
+    _node: Node<ipc::Service>,
+    fc: Publisher<ipc::Service, [f64], ForecastHeader>,
+    st: Publisher<ipc::Service, Status, ()>,
+    fc_n: Notifier<ipc::Service>,
+    st_n: Notifier<ipc::Service>,
+}
+
+impl OutputPublisher {
+    pub fn new(names: &Names) -> Result<OutputPublisher> {
+        let node = node()?;
+        let fc = forecast_service(&node, names)?
+            .publisher_builder()
+            .initial_max_slice_len(6 * MAX_VESSELS * 6001)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(err)?;
+        let st = status_service(&node, names)?
+            .publisher_builder()
+            .create()
+            .map_err(err)?;
+        let (fc_n, _) = event(&node, names, "forecast")?;
+        let (st_n, _) = event(&node, names, "status")?;
+        Ok(OutputPublisher {
+            _node: node,
+            fc,
+            st,
+            fc_n,
+            st_n,
+        })
+    }
+
+    pub fn publish(&self, out: &Output) -> Result<()> {
+        match out {
+            Output::Forecast(h, values) => {
+                let s = self.fc.loan_slice_uninit(values.len()).map_err(err)?;
+                let mut s = s.write_from_slice(values);
+                *s.user_header_mut() = *h;
+                s.send().map_err(err)?;
+                self.fc_n.notify().map_err(err)?;
+            }
+            Output::Status(status) => {
+                let s = self.st.loan_uninit().map_err(err)?;
+                s.write_payload(*status).send().map_err(err)?;
+                self.st_n.notify().map_err(err)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The link's health publisher (`shipcast link`), on `<prefix>/link`.
+pub struct LinkPublisher {
+    _node: Node<ipc::Service>,
+    link: Publisher<ipc::Service, LinkStatus, ()>,
+}
+
+impl LinkPublisher {
+    pub fn new(names: &Names) -> Result<LinkPublisher> {
+        let node = node()?;
+        let link = link_service(&node, names)?.publisher_builder().create().map_err(err)?;
+        Ok(LinkPublisher { _node: node, link })
+    }
+
+    pub fn publish(&self, s: &LinkStatus) -> Result<()> {
+        self.link
+            .loan_uninit()
+            .map_err(err)?
+            .write_payload(*s)
+            .send()
+            .map_err(err)?;
+        Ok(())
+    }
+}
+
+/// What the link sends of the local services: own vessels' motion and navigation, the daemon's
+/// forecasts and status. A blocking subscriber.
+pub struct LocalSubscriber {
+    _node: Node<ipc::Service>,
+    motion: Subscriber<ipc::Service, MotionSample, ()>,
+    nav: Subscriber<ipc::Service, NavigationSample, ()>,
+    forecast: Subscriber<ipc::Service, [f64], ForecastHeader>,
+    status: Subscriber<ipc::Service, Status, ()>,
+    listeners: Vec<Listener<ipc::Service>>,
+    ws: WaitSet<ipc::Service>,
+}
+
+/// One local message for the link.
+#[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
+pub enum Local {
+    Motion(MotionSample),
+    Navigation(NavigationSample),
+    Output(Output),
+}
+
+impl LocalSubscriber {
+    pub fn new(names: &Names) -> Result<LocalSubscriber> {
+        let node = node()?;
+        let motion = motion_service(&node, names)?
+            .subscriber_builder()
+            .buffer_size(BUFFER)
+            .create()
+            .map_err(err)?;
+        let nav = navigation_service(&node, names)?
+            .subscriber_builder()
+            .buffer_size(BUFFER)
+            .create()
+            .map_err(err)?;
+        let forecast = forecast_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let status = status_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let mut listeners = vec![];
+        for kind in ["motion", "navigation", "forecast", "status"] {
+            listeners.push(event(&node, names, kind)?.1);
+        }
+        Ok(LocalSubscriber {
+            _node: node,
+            motion,
+            nav,
+            forecast,
+            status,
+            listeners,
+            ws: waitset()?,
+        })
+    }
+
+    /// Waits up to `timeout` for a notification, then everything received; what does not fit its
+    /// header is skipped (the link sends nothing a local subscriber would refuse).
+    pub fn wait(&self, timeout: Duration, out: &mut Vec<Local>) -> Result<()> {
+        let mut guards = vec![];
+        for l in &self.listeners {
+            guards.push(self.ws.attach_notification(l).map_err(err)?);
+        }
+        let _ = self
+            .ws
+            .wait_and_process_once_with_timeout(|_| CallbackProgression::Stop, timeout)
+            .map_err(err)?;
+        drop(guards);
+        for l in &self.listeners {
+            let _ = l.try_wait(|_| {});
+        }
+        while let Some(s) = self.motion.receive().map_err(err)? {
+            out.push(Local::Motion(*s.payload()));
+        }
+        while let Some(s) = self.nav.receive().map_err(err)? {
+            out.push(Local::Navigation(*s.payload()));
+        }
+        while let Some(s) = self.forecast.receive().map_err(err)? {
+            if check_forecast(s.user_header(), s.payload().len()).is_ok() {
+                out.push(Local::Output(Output::Forecast(*s.user_header(), s.payload().to_vec())));
+            }
+        }
+        while let Some(s) = self.status.receive().map_err(err)? {
+            if check_status(s.payload()).is_ok() {
+                out.push(Local::Output(Output::Status(*s.payload())));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Publishers of a sensor suite (the simulator, or a bridge from real sensors): blocking.

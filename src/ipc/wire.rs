@@ -1,5 +1,5 @@
 //! The iceoryx2 wire types: what goes over shared memory, field by field (schema version 1; the
-//! forecast's 2, the status's 3).
+//! forecast's 2, the status's 4, the link's 1).
 //!
 //! Every payload is `#[repr(C)]` with a stable type name, so a C, C++ or Python subscriber can declare
 //! the same layout (`tools/console/subscriber.py` does it with ctypes). Units SI; times are seconds on
@@ -22,6 +22,7 @@
 //!   standard deviations, same order (the forecast's band: `rom::spread`). Schema version
 //!   [`FORECAST_SCHEMA_VERSION`].
 //! - `status`: [`Status`].
+//! - `link`: [`LinkStatus`], from `shipcast link` (the ship-to-ship link), when one runs.
 
 use crate::waves::field::FlatHeader;
 use iceoryx2::prelude::*;
@@ -33,7 +34,7 @@ pub const SCHEMA_VERSION: u32 = 1;
 pub const FORECAST_SCHEMA_VERSION: u32 = 2;
 /// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
 /// estimator's refusals, restarts and bias).
-pub const STATUS_SCHEMA_VERSION: u32 = 3;
+pub const STATUS_SCHEMA_VERSION: u32 = 4;
 /// Vessels a forecast or status can describe.
 pub const MAX_VESSELS: usize = 4;
 /// The most components a wave field may carry: the wavenumber bins of a 256 x 256 radar grid. A field
@@ -56,7 +57,8 @@ pub fn check_wave_components(n: usize) -> Result<(), String> {
 pub mod flags {
     /// The newest wave field is older than `max_wave_age_s`.
     pub const STALE_WAVES: u32 = 1;
-    /// A vessel's newest motion sample is older than `max_motion_age_s`.
+    /// A vessel's newest motion sample is older than `max_motion_age_s` (the status's `motion_age_s`
+    /// says which): a forecast starts it from rest and trusts it nowhere (its horizon 0).
     pub const STALE_MOTION: u32 = 2;
     /// Less motion history than the radiation memory: the oldest part is taken as at rest.
     pub const HISTORY_SHORT: u32 = 4;
@@ -122,7 +124,7 @@ pub mod flags {
 }
 
 /// One motion/navigation sample of one vessel. 112 bytes.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[type_name("shipcast_MotionSample_v1")]
 #[repr(C)]
 pub struct MotionSample {
@@ -141,7 +143,7 @@ pub struct MotionSample {
 /// Marine conventions at this edge: compass angles in degrees clockwise from true north, rate of turn
 /// positive to starboard; the daemon converts them once, on arrival, to its earth frame (x east, y
 /// north, angles counterclockwise from east, rad). Optional values are marked in `valid`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[type_name("shipcast_NavigationSample_v1")]
 #[repr(C)]
 pub struct NavigationSample {
@@ -256,7 +258,7 @@ impl WaveHeader {
 }
 
 /// Header of a forecast sample. 128 bytes; `schema_version` = [`FORECAST_SCHEMA_VERSION`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[type_name("shipcast_ForecastHeader_v2")]
 #[repr(C)]
 pub struct ForecastHeader {
@@ -286,9 +288,9 @@ pub struct ForecastHeader {
     pub trusted_from_s: [f64; MAX_VESSELS],
 }
 
-/// Health of the daemon, published every cycle. 360 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("shipcast_Status_v3")]
+/// Health of the daemon, published every cycle. 384 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
+#[type_name("shipcast_Status_v4")]
 #[repr(C)]
 pub struct Status {
     pub schema_version: u32,
@@ -336,7 +338,50 @@ pub struct Status {
     pub motion_bias: [[f64; 3]; MAX_VESSELS],
     /// 1 while running, 0 in the last status before a clean shutdown.
     pub running: u32,
-    pub reserved: u32,
+    /// The ship-to-ship link (`shipcast link`, its [`LinkStatus`] on `<prefix>/link`): 0 none heard
+    /// of, 1 up, 2 down (no message from the other ship lately, or the link process itself silent).
+    pub link_state: u32,
+    /// The link's median latency over its window, ms (-1: none measured).
+    pub link_latency_ms: f64,
+    /// The link's share of messages lost over its window, 0..1 (-1: none heard of).
+    pub link_loss: f64,
+    /// Age of the newest message from the other ship, s (-1: none yet).
+    pub link_age_s: f64,
+}
+
+/// The link's state (`link_state` of [`Status`]).
+pub mod link_state {
+    pub const NONE: u32 = 0;
+    pub const UP: u32 = 1;
+    pub const DOWN: u32 = 2;
+}
+
+/// Schema version of [`LinkStatus`].
+pub const LINK_SCHEMA_VERSION: u32 = 1;
+
+/// Health of the ship-to-ship link, published by `shipcast link` every `link.health_period_s` on
+/// `<prefix>/link`. 64 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("shipcast_LinkStatus_v1")]
+#[repr(C)]
+pub struct LinkStatus {
+    pub schema_version: u32,
+    /// 1 while messages from the other ship arrive (the newest within `link.stale_s`), else 0.
+    pub up: u32,
+    /// Wall-clock time of this status (UNIX s).
+    pub wall_time_s: f64,
+    /// Median latency of the messages received over the window, ms: receipt less the sender's stamp
+    /// (both hosts' clocks: GNSS-disciplined on a ship; exact on one host). -1: none in the window.
+    pub latency_ms: f64,
+    /// Share of the messages lost over the window (gaps in each stream's sequence), 0..1 (-1: none
+    /// received in it).
+    pub loss: f64,
+    /// Age of the newest message from the other ship, s (-1: none yet).
+    pub last_message_age_s: f64,
+    /// Messages received, lost and sent since the link started.
+    pub received: u64,
+    pub lost: u64,
+    pub sent: u64,
 }
 
 /// Checks a received forecast against its own header, as every consumer must before indexing it
@@ -484,6 +529,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<ElevationHeader>(), 64);
         assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 128);
-        assert_eq!(std::mem::size_of::<Status>(), 360);
+        assert_eq!(std::mem::size_of::<Status>(), 384);
+        assert_eq!(std::mem::size_of::<LinkStatus>(), 64);
     }
 }

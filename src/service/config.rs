@@ -27,6 +27,8 @@ pub struct ShipcastConfig {
     pub operation: OperationConfig,
     #[serde(default)]
     pub console: ConsoleConfig,
+    #[serde(default)]
+    pub link: LinkConfig,
     /// Directory of the config file (relative paths are resolved against it); set by [`load`].
     #[serde(skip)]
     pub dir: PathBuf,
@@ -94,7 +96,8 @@ pub struct ForecastConfig {
     pub max_wave_age_s: f64,
     /// ... and beyond this no forecast is published (status only), s.
     pub suppress_wave_age_s: f64,
-    /// No motion sample received for this long (wall clock): stale motion, no forecast, s.
+    /// A vessel without a motion sample for this long (wall clock) is stale: forecast from rest and
+    /// trusted nowhere (flag `stale_motion`); every vessel stale: no forecast, s.
     pub max_motion_age_s: f64,
     /// Gaps in the motion history up to this long are bridged (by the estimator's curve through both
     /// ends); a longer one ends the history (what is before it counts as at rest), s.
@@ -470,6 +473,72 @@ pub struct ChannelConfig {
     pub limit: f64,
 }
 
+/// The ship-to-ship link (`shipcast link`): this host's iceoryx2 services bridged to the other ship's
+/// over Zenoh.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LinkConfig {
+    /// This ship's name on the link (unique among the operation's participants).
+    pub name: String,
+    /// The operation: Zenoh keys are `shipcast/<namespace>/<name>/<kind>`; links of another namespace
+    /// see nothing of this one.
+    pub namespace: String,
+    /// Zenoh endpoints to listen on (`tcp/0.0.0.0:7447`).
+    pub listen: Vec<String>,
+    /// Zenoh endpoints of the other ship's link to connect to (`tcp/10.0.0.2:7447`); retried while
+    /// it is away.
+    pub connect: Vec<String>,
+    /// The vessels (indices of the system file) whose motion and navigation are measured on this
+    /// ship: sent out; the others' are taken in.
+    pub own_vessels: Vec<u32>,
+    /// Send this ship's forecasts and status.
+    pub forecasts_out: bool,
+    /// The iceoryx2 prefix the other ship's forecasts and status are published under here (default
+    /// `<ipc.service_prefix>/peer`).
+    pub peer_prefix: String,
+    /// No message from the other ship for this long: the link is down, s.
+    pub stale_s: f64,
+    /// Latency and loss are over this window, s.
+    pub window_s: f64,
+}
+
+impl Default for LinkConfig {
+    fn default() -> Self {
+        LinkConfig {
+            name: "ship".into(),
+            namespace: "shipcast".into(),
+            listen: vec![],
+            connect: vec![],
+            own_vessels: vec![0],
+            forecasts_out: true,
+            peer_prefix: String::new(),
+            stale_s: 2.0,
+            window_s: 30.0,
+        }
+    }
+}
+
+impl LinkConfig {
+    /// The prefix of the other ship's forecasts and status here.
+    pub fn peer_prefix_of(&self, ipc: &IpcConfig) -> String {
+        if self.peer_prefix.is_empty() {
+            format!("{}/peer", ipc.service_prefix)
+        } else {
+            self.peer_prefix.clone()
+        }
+    }
+}
+
+/// A Zenoh key chunk: not empty, no `/`, `*`, `$`, `?`, `#` (they mean something in key expressions).
+fn check_key_chunk(what: &str) -> Result<(), String> {
+    if what.is_empty() || what.len() > 100 || what.chars().any(|c| "/*$?#".contains(c) || c.is_whitespace()) {
+        return Err(format!(
+            "\"{what}\" is not a Zenoh key chunk: 1..100 characters, none of / * $ ? # or spaces"
+        ));
+    }
+    Ok(())
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ConsoleConfig {
@@ -779,6 +848,9 @@ pub const BOUNDS: &[Bound] = &[
     // refused samples in a row before a jump is believed: a few seconds of motion at 1000 Hz
     closed("estimator.reset_samples", 1.0, 1000.0, ""),
     positive("estimator.bias_time_s", DAY_S, "s"),
+    // a radio link's outage is told from its jitter in a second or two; an hour is no link
+    positive("link.stale_s", 3600.0, "s"),
+    positive("link.window_s", DAY_S, "s"),
     closed("estimator.angle_bias_rad", 0.0, 0.1, "rad"),
     // a terabyte of messages per file at most
     positive("record.rotate_mb", 1.0e6, "MB"),
@@ -884,6 +956,8 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("estimator.gate_sigma", c.estimator.gate_sigma),
         one("estimator.reset_samples", c.estimator.reset_samples as f64),
         one("estimator.bias_time_s", c.estimator.bias_time_s),
+        one("link.stale_s", c.link.stale_s),
+        one("link.window_s", c.link.window_s),
         one("estimator.angle_bias_rad", c.estimator.angle_bias_rad),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
@@ -1076,6 +1150,22 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         return Err(("ipc.service_prefix".into(), "must be 1..200 characters".into()));
     }
     check_service_prefix(&c.ipc.service_prefix).map_err(|m| ("ipc.service_prefix".to_string(), m))?;
+    check_key_chunk(&c.link.name).map_err(|m| ("link.name".to_string(), m))?;
+    check_key_chunk(&c.link.namespace).map_err(|m| ("link.namespace".to_string(), m))?;
+    if !c.link.peer_prefix.is_empty() {
+        check_service_prefix(&c.link.peer_prefix).map_err(|m| ("link.peer_prefix".to_string(), m))?;
+    }
+    if let Some(v) = c
+        .link
+        .own_vessels
+        .iter()
+        .find(|v| **v as usize >= crate::ipc::wire::MAX_VESSELS)
+    {
+        return Err((
+            "link.own_vessels".into(),
+            format!("vessel {v}: indices 0..{}", crate::ipc::wire::MAX_VESSELS),
+        ));
+    }
     c.console.colours.parse()?;
     let sea = &c.simulate.sea;
     if sea.omega_min_rad_s >= sea.omega_max_rad_s {

@@ -18,7 +18,7 @@ pub mod estimator;
 pub mod navigation;
 
 use crate::hydro::VesselSystem;
-use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags};
+use crate::ipc::wire::{ForecastHeader, MAX_VESSELS, MotionSample, SCHEMA_VERSION, Status, flags, link_state};
 use crate::ipc::{self, Input, Names, Output};
 use crate::rom::spread::{self, ResponseTable, SpreadOptions};
 use crate::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel, Track};
@@ -145,6 +145,10 @@ pub struct Done {
     /// with no trusted span teaches all the same: its error is the model's).
     pub teaches: bool,
 }
+
+/// The link is down when its process has said nothing for this long, s (three of its health
+/// messages missed: `link::HEALTH_PERIOD_S`).
+pub const LINK_SILENT_S: f64 = 3.0;
 
 /// The DOFs (roll, pitch) whose forecast keeps the measured mean (the estimator's bias) where it is
 /// further from the model's own mean in waves than the sensor's bias can be
@@ -633,6 +637,8 @@ pub struct Engine {
     last_forecast_time: f64,
     last_compute_ms: f64,
     last_horizon: [f64; MAX_VESSELS],
+    /// The ship-to-ship link's newest health, and the engine clock it arrived at.
+    link: Option<(crate::ipc::wire::LinkStatus, f64)>,
     state_flags: u32,
     /// The model error learnt from past forecasts against the motion that followed, and the checks
     /// at 30 s when it was last logged.
@@ -649,6 +655,8 @@ pub struct Engine {
     /// [`MEASURED_MEAN_DOFS`], the measured mean (the estimator's bias) less the model's own (the
     /// model forecasts the motion about its mean, the mean is as measured).
     job_offset: Vec<[f64; 6]>,
+    /// Per vessel, whether the running job started it from rest for want of fresh motion.
+    job_unknown: Vec<bool>,
 }
 
 impl Engine {
@@ -707,11 +715,13 @@ impl Engine {
             last_forecast_time: -1.0,
             last_compute_ms: 0.0,
             last_horizon: [0.0; MAX_VESSELS],
+            link: None,
             state_flags: 0,
             model_error_logged: 0,
             model_mean: vec![Default::default(); n_bodies],
             model_mean_time_s: None,
             job_offset: vec![[0.0; 6]; n_bodies],
+            job_unknown: vec![false; n_bodies],
             bias_time_s: cfg.estimator.bias_time_s,
             angle_bias_rad: cfg.estimator.angle_bias_rad,
             model_error: spread::ModelError::new(
@@ -733,9 +743,16 @@ impl Engine {
 
     /// The earliest and the latest of the vessels' newest motion stamps, s (+inf and -inf before any).
     fn newest_motion_s(&self) -> (f64, f64) {
+        self.newest_motion_of(&vec![true; self.hist.len()])
+    }
+
+    /// [`Self::newest_motion_s`] over the vessels where `which` is true.
+    fn newest_motion_of(&self, which: &[bool]) -> (f64, f64) {
         self.hist
             .iter()
-            .filter_map(|h| h.newest_time_s())
+            .zip(which)
+            .filter(|(_, w)| **w)
+            .filter_map(|(h, _)| h.newest_time_s())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)))
     }
 
@@ -905,6 +922,17 @@ impl Engine {
                     self.field = Some(f);
                 }
             }
+            Input::Link(l) => {
+                if l.schema_version == crate::ipc::wire::LINK_SCHEMA_VERSION {
+                    self.link = Some((l, clock_s));
+                } else {
+                    c.rejected += 1;
+                    log_count(
+                        c.rejected,
+                        &format!("link status of schema version {}: refused", l.schema_version),
+                    );
+                }
+            }
             Input::Rejected(why) => {
                 c.rejected += 1;
                 tracing::warn!("input rejected: {why}");
@@ -927,7 +955,14 @@ impl Engine {
         if motion_ok.iter().any(|ok| !ok) {
             fl |= flags::STALE_MOTION;
         }
-        let (t0, newest) = self.newest_motion_s();
+        // a vessel whose motion is stale or missing (the other ship's, when the link between them is
+        // down) does not stop the others' forecasts: the model starts it from rest at its mean in
+        // waves, it is trusted nowhere and its band is the motion's own, and its error reaches the
+        // fresh vessels through the coupling (lines, fenders, the water between them)
+        let motion_fresh: Vec<bool> = (0..n_bodies)
+            .map(|b| motion_ok[b] && self.hist[b].newest_time_s().is_some())
+            .collect();
+        let (t0, newest) = self.newest_motion_of(&motion_fresh);
         // the sources' clocks must agree: vessels' newest motion within the staleness and the skew of
         // each other, and no wave field from after the motion beyond the skew
         let mut disagree = newest - t0 > cfg.max_motion_age_s + cfg.max_clock_skew_s;
@@ -947,8 +982,8 @@ impl Engine {
             Some(a) if a > cfg.max_wave_age_s => fl |= flags::STALE_WAVES,
             _ => {}
         }
-        let can = fl & (flags::NO_WAVES | flags::NO_MOTION | flags::STALE_MOTION | flags::CLOCKS_DISAGREE) == 0
-            && t0.is_finite();
+        let can =
+            fl & (flags::NO_WAVES | flags::CLOCKS_DISAGREE) == 0 && motion_fresh.iter().any(|f| *f) && t0.is_finite();
         if self.forecasting != Some(can) {
             let why = flags::names(fl).join(", ");
             match (self.forecasting, can) {
@@ -972,6 +1007,15 @@ impl Engine {
             let mut offset = vec![[0.0; 6]; n_bodies];
             let mut ok = true;
             for b in 0..n_bodies {
+                if !motion_fresh[b] {
+                    // at rest at the model's own mean in waves, no history
+                    for (row, &i) in self.active.iter().enumerate() {
+                        if i / 6 == b && i < 6 * n_bodies {
+                            x0[row] = self.model_mean[b].value[i % 6];
+                        }
+                    }
+                    continue;
+                }
                 let Some(r) = self.hist[b].resample(t0, dt, n_hist, cfg.max_gap_s) else {
                     ok = false;
                     break;
@@ -1131,6 +1175,7 @@ impl Engine {
                 fl = header.flags;
                 self.busy = true;
                 self.job_offset = offset;
+                self.job_unknown = motion_fresh.iter().map(|f| !f).collect();
                 job = Some(Job {
                     t0_s: t0,
                     x0,
@@ -1170,8 +1215,12 @@ impl Engine {
                 // only forecasts whose waves the daemon trusts teach it the model's error (an
                 // untrusted field's error is its waves'), with or without a trusted span
                 let n = (header.steps as usize + 1) * header.n_series as usize;
-                let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share;
+                let unknown = self.job_unknown.iter().any(|u| *u);
+                let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share && !unknown;
                 let mut values = values;
+                if unknown {
+                    self.unknown_start(&mut header, &mut values, &d.motion_sigma);
+                }
                 if values.len() == 2 * n {
                     self.learn_model_mean(&header, &values[..n]);
                     self.shift_to_measured_mean(&header, &mut values[..n]);
@@ -1220,6 +1269,32 @@ impl Engine {
                 mean[d] = series.iter().sum::<f64>() / series.len() as f64;
             }
             m.add(dt, &mean, self.bias_time_s);
+        }
+    }
+
+    /// A forecast that started vessels from rest for want of their motion: nothing of theirs is trusted
+    /// (horizon 0), and their band is at least the error of a guess unrelated to the motion, twice
+    /// its variance (`motion_sigma`: the model's response to the whole sea), as for unknown waves.
+    fn unknown_start(&self, header: &mut ForecastHeader, values: &mut [f64], motion_sigma: &[f64]) {
+        let per = header.steps as usize + 1;
+        let n = per * header.n_series as usize;
+        for (b, _) in self.job_unknown.iter().enumerate().filter(|(_, u)| **u) {
+            if b < MAX_VESSELS {
+                header.horizon_s[b] = 0.0;
+                header.trusted_from_s[b] = 0.0;
+            }
+            if values.len() != 2 * n {
+                continue;
+            }
+            for i in 6 * b..(6 * b + 6).min(header.n_series as usize) {
+                let floor = std::f64::consts::SQRT_2 * motion_sigma.get(i).copied().unwrap_or(f64::NAN);
+                for s in &mut values[n + i * per..n + (i + 1) * per] {
+                    // NaN (no band known) stays NaN
+                    if floor.is_finite() && *s < floor {
+                        *s = floor;
+                    }
+                }
+            }
         }
     }
 
@@ -1277,6 +1352,23 @@ impl Engine {
             motion_restarts: c.motion_restarts,
             running: running as u32,
             ..Status::default()
+        };
+        (s.link_state, s.link_latency_ms, s.link_loss, s.link_age_s) = match self.link {
+            None => (link_state::NONE, -1.0, -1.0, -1.0),
+            Some((l, at)) => {
+                let since = (clock_s - at).max(0.0);
+                let up = l.up == 1 && since <= LINK_SILENT_S;
+                (
+                    if up { link_state::UP } else { link_state::DOWN },
+                    l.latency_ms,
+                    l.loss,
+                    if l.last_message_age_s >= 0.0 {
+                        l.last_message_age_s + since
+                    } else {
+                        -1.0
+                    },
+                )
+            }
         };
         for (b, h) in self.hist.iter().enumerate() {
             s.motion_age_s[b] = self.arrival[b].map(|a| clock_s - a).unwrap_or(-1.0);
@@ -1359,7 +1451,8 @@ fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, 
             t,
             Record::Elevation(Box::new(crate::record::GridRecord::of_scan(scan))),
         ),
-        Input::Rejected(_) => {}
+        // the link's health changes no forecast
+        Input::Rejected(_) | Input::Link(_) => {}
     }
 }
 
