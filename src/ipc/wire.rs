@@ -359,7 +359,7 @@ pub mod link_state {
 /// Schema version of [`LinkStatus`].
 pub const LINK_SCHEMA_VERSION: u32 = 1;
 
-/// Health of the ship-to-ship link, published by `shipcast link` every `link.health_period_s` on
+/// Health of the ship-to-ship link, published by `shipcast link` every second (`link::HEALTH_PERIOD_S`) on
 /// `<prefix>/link`. 64 bytes.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[type_name("shipcast_LinkStatus_v1")]

@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 use zenoh::Wait;
 use zenoh::qos::CongestionControl;
+use zenoh::sample::Locality;
 
 /// One message between the links: its stream's number, the sender's wall clock and what it carries
 /// (postcard-encoded).
@@ -193,12 +194,15 @@ fn receive_loop(
     let health_out = LinkPublisher::new(own).map_err(iox)?;
     let sub = session
         .declare_subscriber(format!("shipcast/{}/*/*", cfg.link.namespace))
+        // the other ship's only: not this link's own puts
+        .allowed_origin(Locality::Remote)
         .wait()
         .map_err(|e| anyhow::anyhow!("Zenoh subscriber: {e}"))?;
     let mut health = Health::new(cfg.link.window_s, cfg.link.stale_s);
     let mut next_health = wall_s();
     let mut was_up: Option<bool> = None;
     let (mut refused, mut foreign) = (0u64, 0u64);
+    let mut same_name_said = false;
     while !stop.load(Ordering::Relaxed) {
         let now = wall_s();
         if now >= next_health {
@@ -231,8 +235,9 @@ fn receive_loop(
         let k = sample.key_expr().as_str();
         let mut parts = k.rsplit('/');
         let (kind, from) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
-        if from == cfg.link.name {
-            continue;
+        if from == cfg.link.name && !same_name_said {
+            same_name_said = true;
+            tracing::warn!("the other ship's link is also named {from:?}: give each ship its own [link] name");
         }
         let env: Envelope = match postcard::from_bytes(&sample.payload().to_bytes()) {
             Ok(e) => e,

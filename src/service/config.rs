@@ -1154,6 +1154,15 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     check_key_chunk(&c.link.namespace).map_err(|m| ("link.namespace".to_string(), m))?;
     if !c.link.peer_prefix.is_empty() {
         check_service_prefix(&c.link.peer_prefix).map_err(|m| ("link.peer_prefix".to_string(), m))?;
+        if c.link.peer_prefix == c.ipc.service_prefix {
+            return Err((
+                "link.peer_prefix".into(),
+                format!(
+                    "\"{}\" is ipc.service_prefix: the other ship's forecasts would be taken for this ship's and sent back",
+                    c.link.peer_prefix
+                ),
+            ));
+        }
     }
     if let Some(v) = c
         .link
