@@ -129,20 +129,29 @@ fn rms_error_at(fs: &[Forecast], vessel: usize, dof: usize, lead_s: f64) -> f64 
     rms_error_of(log(), fs, vessel, dof, lead_s)
 }
 
+/// A time as the key of [`truth_of`]: whole ms.
+fn ms(t_s: f64) -> i64 {
+    (t_s * 1000.0).round() as i64
+}
+
+/// The truth of (vessel, dof) in log `l`, by time ([`ms`]).
+fn truth_of(l: &SimLog, vessel: usize, dof: usize) -> BTreeMap<i64, f64> {
+    l.records
+        .iter()
+        .filter_map(|(_, r)| match r {
+            Record::Truth(m) if m.vessel as usize == vessel => Some((ms(m.time_s), m.x[dof])),
+            _ => None,
+        })
+        .collect()
+}
+
 /// RMS error at `lead_s` against the truth of (vessel, dof) in log `l`.
 fn rms_error_of(l: &SimLog, fs: &[Forecast], vessel: usize, dof: usize, lead_s: f64) -> f64 {
-    let mut truth = BTreeMap::new();
-    for (_, r) in &l.records {
-        if let Record::Truth(m) = r
-            && m.vessel as usize == vessel
-        {
-            truth.insert((m.time_s * 1000.0).round() as i64, m.x[dof]);
-        }
-    }
+    let truth = truth_of(l, vessel, dof);
     let (mut se, mut n) = (0.0, 0usize);
     for f in fs {
         let t = f.header.issue_time_s + lead_s;
-        if let (Some(x), Some(tr)) = (f.at(vessel, dof, t), truth.get(&((t * 1000.0).round() as i64))) {
+        if let (Some(x), Some(tr)) = (f.at(vessel, dof, t), truth.get(&ms(t))) {
             se += (x - tr).powi(2);
             n += 1;
         }
@@ -228,19 +237,12 @@ fn a_heel_the_model_does_not_know_is_kept() {
                 continue;
             }
             let e = rms_error_of(l, &late, v, d, 0.0) / std;
-            let truth_at: BTreeMap<i64, f64> = l
-                .records
-                .iter()
-                .filter_map(|(_, r)| match r {
-                    Record::Truth(m) if m.vessel == v as u32 => Some(((m.time_s * 1000.0).round() as i64, m.x[d])),
-                    _ => None,
-                })
-                .collect();
+            let truth_at = truth_of(l, v, d);
             let inside: Vec<bool> = late
                 .iter()
                 .filter_map(|f| {
                     let t = f.header.issue_time_s;
-                    let tr = truth_at.get(&((t * 1000.0).round() as i64))?;
+                    let tr = truth_at.get(&ms(t))?;
                     Some((f.at(v, d, t)? - tr).abs() <= 1.645 * f.sigma_at_start(v, d))
                 })
                 .collect();
@@ -348,22 +350,13 @@ fn a_vessel_whose_motion_stops_is_forecast_from_rest_and_trusted_nowhere() {
         assert!(h.flags & shipcast::ipc::wire::flags::STALE_MOTION != 0, "{:?}", h.flags);
         assert_eq!(h.horizon_s[1], 0.0);
     }
-    let truth_at = |v: u32, d: usize| -> BTreeMap<i64, f64> {
-        l.records
-            .iter()
-            .filter_map(|(_, r)| match r {
-                Record::Truth(m) if m.vessel == v => Some(((m.time_s * 1000.0).round() as i64, m.x[d])),
-                _ => None,
-            })
-            .collect()
-    };
     let rms = |fs: &[Forecast], v: usize, d: usize, lead_s: f64| -> f64 {
-        let truth = truth_at(v as u32, d);
+        let truth = truth_of(l, v, d);
         let e: Vec<f64> = fs
             .iter()
             .filter_map(|f| {
                 let t = f.header.issue_time_s + lead_s;
-                Some(f.at(v, d, t)? - truth.get(&((t * 1000.0).round() as i64))?)
+                Some(f.at(v, d, t)? - truth.get(&ms(t))?)
             })
             .collect();
         (e.iter().map(|x| x * x).sum::<f64>() / e.len().max(1) as f64).sqrt()
@@ -380,7 +373,7 @@ fn a_vessel_whose_motion_stops_is_forecast_from_rest_and_trusted_nowhere() {
     }
     // the share of the truth of (v, d) inside the published 90 % band at leads 0-60 s
     let coverage = |fs: &[Forecast], v: usize, d: usize| -> (f64, usize) {
-        let truth = truth_at(v as u32, d);
+        let truth = truth_of(l, v, d);
         let (mut inside, mut n) = (0, 0);
         for f in fs {
             let h = &f.header;
@@ -389,7 +382,7 @@ fn a_vessel_whose_motion_stops_is_forecast_from_rest_and_trusted_nowhere() {
             let base = h.n_series as usize * per;
             for k in (0..per).step_by(10).take_while(|k| *k as f64 * h.dt_s <= 60.0) {
                 let t = h.issue_time_s + k as f64 * h.dt_s;
-                if let Some(tr) = truth.get(&((t * 1000.0).round() as i64)) {
+                if let Some(tr) = truth.get(&ms(t)) {
                     n += 1;
                     if (f.values[s + k] - tr).abs() <= 1.645 * f.values[base + s + k] {
                         inside += 1;
