@@ -2,7 +2,9 @@
 //! correlation, the normalized RMS error (RMS error / standard deviation of the measurement), the
 //! surface similarity parameter SSP = |f - m| / (|f| + |m|) (0 perfect, 1 no skill) and the bias
 //! (mean of f - m), and the band's coverage: the fraction of the measurement inside the forecast's
-//! published 90 % band (f +- 1.645 sigma, sigma the forecast's standard deviation). Leads are the
+//! published 90 % band (f +- 1.645 sigma, sigma the forecast's standard deviation), and its
+//! spread-skill ratio: the RMS of sigma over the RMS error of the same pairs (1 when the band is as
+//! wide as the errors are; above 1 a band wider than it need be, below 1 too narrow). Leads are the
 //! forecast's own steps, binned to `lead_step_s`.
 //!
 //! Inputs: forecasts as (issue time t0, dt, values at t0 + k dt) and the measured series as samples
@@ -34,6 +36,9 @@ pub struct Skill {
     pub count: Vec<usize>,
     /// Fraction of the measurement inside the 90 % band at each lead (NaN: no forecast had a band).
     pub coverage_90: Vec<f64>,
+    /// RMS of the band's standard deviation over the RMS error of the pairs with a band, at each
+    /// lead (NaN: no band, or no error).
+    pub spread_skill: Vec<f64>,
 }
 
 /// Linear interpolation in a sorted (time, value) series; None outside it.
@@ -67,8 +72,9 @@ pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
 pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s: f64, max_lead_s: f64) -> Skill {
     let nl = (max_lead_s / lead_step_s).floor() as usize + 1;
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![vec![]; nl];
-    // per lead: pairs with a band, and of them those inside it
+    // per lead: pairs with a band, and of them those inside it; their sum of sigma^2 and of error^2
     let mut covered = vec![(0usize, 0usize); nl];
+    let mut spread = vec![(0.0f64, 0.0f64); nl];
     for f in forecasts {
         for (l, p) in pairs.iter_mut().enumerate() {
             let lead = l as f64 * lead_step_s;
@@ -81,6 +87,8 @@ pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s:
                 if let Some(s) = f.sigma.get(k).filter(|s| s.is_finite()) {
                     covered[l].0 += 1;
                     covered[l].1 += usize::from((m - v).abs() <= Z_90 * s);
+                    spread[l].0 += s * s;
+                    spread[l].1 += (m - v) * (m - v);
                 }
             }
         }
@@ -95,6 +103,10 @@ pub fn score(forecasts: &[SeriesForecast], measured: &[(f64, f64)], lead_step_s:
         coverage_90: covered
             .iter()
             .map(|(n, inside)| if *n > 0 { *inside as f64 / *n as f64 } else { f64::NAN })
+            .collect(),
+        spread_skill: spread
+            .iter()
+            .map(|(s2, e2)| if *e2 > 0.0 { (s2 / e2).sqrt() } else { f64::NAN })
             .collect(),
     };
     for p in &pairs {
@@ -171,6 +183,7 @@ mod tests {
         assert!(s.correlation[0] > 0.999 && s.correlation[6] < s.correlation[1]);
         assert!(s.nrmse[6] > s.nrmse[1]);
         assert!(s.coverage_90.iter().all(|c| c.is_nan()));
+        assert!(s.spread_skill.iter().all(|c| c.is_nan()));
     }
 
     #[test]
@@ -193,6 +206,10 @@ mod tests {
         // three quarters of the samples are inside 1.645 sigma
         for c in &s.coverage_90 {
             assert!((c - 0.75).abs() < 0.03, "{:?}", s.coverage_90);
+        }
+        // errors 2 and 1 (one in four, three in four): RMS error sqrt(7 / 4), sigma 1
+        for r in &s.spread_skill {
+            assert!((r - (4.0f64 / 7.0).sqrt()).abs() < 0.03, "{:?}", s.spread_skill);
         }
     }
 }

@@ -98,6 +98,12 @@ fn forecasts(drift_window_s: f64) -> Vec<Forecast> {
     forecasts_of(log(), drift_window_s)
 }
 
+/// [`log`]'s forecasts at the daemon's defaults (replayed once for the tests that read them).
+fn log_forecasts() -> &'static [Forecast] {
+    static FS: OnceLock<Vec<Forecast>> = OnceLock::new();
+    FS.get_or_init(|| forecasts(shipcast::rom::drift::DRIFT_WINDOW_S))
+}
+
 fn forecasts_of(l: &SimLog, drift_window_s: f64) -> Vec<Forecast> {
     let mut cfg = l.cfg.clone();
     cfg.forecast.drift_window_s = drift_window_s;
@@ -169,11 +175,12 @@ const HEELED_START_NRMSE: f64 = 0.2;
 
 #[test]
 fn a_moored_vessel_s_forecast_starts_from_its_mean_heel() {
-    let fs: Vec<Forecast> = forecasts(shipcast::rom::drift::DRIFT_WINDOW_S);
+    let fs = log_forecasts();
     let start = log().records.first().map(|r| r.0).unwrap();
     let late: Vec<Forecast> = fs
-        .into_iter()
+        .iter()
         .filter(|f| f.header.issue_time_s - start >= LOG_S / 2.0)
+        .cloned()
         .collect();
     let truth: Vec<f64> = log()
         .records
@@ -264,7 +271,7 @@ fn a_heel_the_model_does_not_know_is_kept() {
 
 #[test]
 fn consecutive_forecasts_agree_and_keep_the_hulls_apart() {
-    let fs = forecasts(shipcast::rom::drift::DRIFT_WINDOW_S);
+    let fs = log_forecasts();
     let raw = forecasts(0.0);
     for (v, name) in [(0, "carrier"), (1, "lighter")] {
         for (d, dof) in [(0, "surge"), (1, "sway")] {
@@ -278,7 +285,7 @@ fn consecutive_forecasts_agree_and_keep_the_hulls_apart() {
             diffs.sort_by(f64::total_cmp);
             let n = diffs.len();
             let (p95, max) = (diffs[n * 95 / 100], diffs[n - 1]);
-            let (with, without) = (rms_error(&fs, v, d), rms_error(&raw, v, d));
+            let (with, without) = (rms_error(fs, v, d), rms_error(&raw, v, d));
             eprintln!(
                 "{name} {dof}: forecasts 1 s apart at {LEAD_S} s lead differ by median {:.3}, p95 {p95:.3}, \
                  max {max:.3} m; RMS error against the truth {with:.3} m ({without:.3} m with the last \
@@ -292,7 +299,7 @@ fn consecutive_forecasts_agree_and_keep_the_hulls_apart() {
     }
     // the gap at the lighter's ends (x = -60, 60 m), at the waterline, over every step of every forecast
     let mut min_gap = f64::INFINITY;
-    for f in &fs {
+    for f in fs {
         for k in 0..=f.header.steps {
             let t = f.header.issue_time_s + k as f64 * f.header.dt_s;
             for x in [-60.0, 60.0] {

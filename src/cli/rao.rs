@@ -159,15 +159,42 @@ pub fn run(args: &RaoArgs) -> Result<()> {
             // a system with databases at several speeds: the one at this speed
             let at = sys.at_speed(args.speed).with_context(context)?;
             let model = TimeModel::new(&at, flag_checked(opts)?).with_context(context)?;
-            let mut table = vec![];
-            for &h in &headings_deg {
-                let r = time_domain_rao(&model, h.to_radians(), &omegas, RegularOptions::default())
-                    .with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
+            // the headings are independent runs: one thread per core, each taking every n-th heading
+            let threads = std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .clamp(1, headings_deg.len().max(1));
+            let runs: Vec<Vec<(usize, _)>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (0..threads)
+                    .map(|t| {
+                        let (model, omegas, headings_deg) = (&model, &omegas, &headings_deg);
+                        scope.spawn(move || {
+                            (t..headings_deg.len())
+                                .step_by(threads)
+                                .map(|ih| {
+                                    let h: f64 = headings_deg[ih];
+                                    (
+                                        ih,
+                                        time_domain_rao(model, h.to_radians(), omegas, RegularOptions::default()),
+                                    )
+                                })
+                                .collect()
+                        })
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|j| j.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                    .collect()
+            });
+            let mut table = vec![vec![]; headings_deg.len()];
+            for (ih, r) in runs.into_iter().flatten() {
+                let h = headings_deg[ih];
+                let r = r.with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
                 tracing::info!(heading_deg = h, settled_s = r.settled_s, "steady state reached");
-                table.push(r.rao);
+                table[ih] = r.rao;
             }
             eprintln!(
-                "shipcast rao: time domain, {:?} radiation (memory {}), dt {} s: {} headings x {} frequencies in {:.2} s",
+                "shipcast rao: time domain, {:?} radiation (memory {}), dt {} s: {} headings x {} frequencies in {:.2} s ({threads} threads)",
                 opts.radiation,
                 model.memory_size(),
                 opts.dt_s,

@@ -495,7 +495,7 @@ fn report(
     let nb = sys.spec.bodies.len();
     let step = 5.0;
     let mut json_vessels = vec![];
-    let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,coverage_90,count\n");
+    let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,coverage_90,spread_skill,count\n");
     let mut curves: Vec<plot::SkillCurve> = vec![];
     let mut lead = vec![];
     for b in 0..nb {
@@ -531,18 +531,26 @@ fn report(
                     .join(",")
             };
             dofs.push(format!(
-                "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"count\":[{}]}}",
+                "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"spread_skill\":[{}],\"count\":[{}]}}",
                 arr(&sk.correlation),
                 arr(&sk.nrmse),
                 arr(&sk.ssp),
                 arr(&sk.bias),
                 arr(&sk.coverage_90),
+                arr(&sk.spread_skill),
                 sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")
             ));
             for l in 0..sk.lead_s.len() {
                 csv.push_str(&format!(
-                    "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
-                    sk.lead_s[l], sk.correlation[l], sk.nrmse[l], sk.ssp[l], sk.bias[l], sk.coverage_90[l], sk.count[l]
+                    "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
+                    sk.lead_s[l],
+                    sk.correlation[l],
+                    sk.nrmse[l],
+                    sk.ssp[l],
+                    sk.bias[l],
+                    sk.coverage_90[l],
+                    sk.spread_skill[l],
+                    sk.count[l]
                 ));
             }
             if ["heave", "roll", "pitch"].contains(dof) {
