@@ -52,6 +52,8 @@ fn benches(c: &mut Criterion) {
                 let opts = SpreadOptions {
                     model_error: ModelErrorCurve::prior(0.15, 12),
                     trusted_nrmse: 0.6,
+                    start_var: vec![],
+                    start_offset: vec![],
                 };
                 let steps = (300.0 / model.opts.dt_s).round() as usize;
                 g.bench_function(format!("{name}_band"), |b| {

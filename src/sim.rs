@@ -517,7 +517,7 @@ fn interp(f: &Forecast, series: &[f64], t_s: f64, i: usize) -> f64 {
 }
 
 /// A standard normal draw (Box-Muller).
-fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+pub(crate) fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let u1: f64 = rng.random::<f64>().max(1e-300);
     let u2: f64 = rng.random();
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()

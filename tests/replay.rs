@@ -180,6 +180,13 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
             assert!(SHORT_LOG_COVERAGE.contains(&c), "{dof} at {l} s: coverage_90 {c}");
         }
     }
+    // at lead 0 the band is the start's own error, neither the sensor's noise (the estimate is
+    // better than one sample) nor the sensor's drift the checks count as error
+    for dof in ["heave", "pitch"] {
+        let c = a["vessels"]["carrier"][dof]["coverage_90"][0].as_f64().unwrap();
+        eprintln!("{dof} at lead 0: coverage_90 {c:.2}");
+        assert!(START_COVERAGE.contains(&c), "{dof} at lead 0: coverage_90 {c}");
+    }
     let (from, to) = (
         a["trusted_from_s"]["carrier"].as_f64().unwrap(),
         a["trusted_horizon_s"]["carrier"].as_f64().unwrap(),
@@ -200,6 +207,10 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
 /// The 90 % band's coverage allowed on a 10-minute log: its first minutes use the configured prior
 /// while the model error is learnt (README, "How far a forecast is trusted": the 30-minute figures).
 const SHORT_LOG_COVERAGE: std::ops::RangeInclusive<f64> = 0.7..=1.0;
+/// ... and at lead 0, where nothing is learnt from the prior: the Show's (measured 0.90 heave, 0.94
+/// pitch; 0.93 and 0.98 when the band there was floored at the sensor's noise and learnt from checks
+/// that counted heave's drift as error).
+const START_COVERAGE: std::ops::RangeInclusive<f64> = 0.85..=0.95;
 /// Inside the median published span, the error a 10-minute log allows: `forecast.trusted_nrmse` (0.6)
 /// and the first minutes' forecasts, made with the prior.
 const SHORT_LOG_SPAN_NRMSE: f64 = 0.75;

@@ -54,8 +54,15 @@ pub const TWIN_SEA: [(&str, &str); 7] = [
         "# masked_sector_deg = [160.0, 200.0]",
     ),
     ("antenna_height_m = 30.0 ", "antenna_height_m = 0.0 "),
-    ("drift_m = 0.02 ", "drift_m = 0.0 "),
-    ("drift_rad = 0.0003 ", "drift_rad = 0.0 "),
+    // [simulate.imu]'s (the [estimator]'s own drift_m and drift_rad say what the daemon assumes)
+    (
+        "drift_m = 0.02                              # standard deviation (",
+        "drift_m = 0.0 # (",
+    ),
+    (
+        "drift_rad = 0.0003                          # standard deviation (",
+        "drift_rad = 0.0 # (",
+    ),
 ];
 
 /// [`TWIN_SEA`] for `config/one-ship.toml` (its sensors at the defaults).

@@ -195,6 +195,13 @@ pub struct EstimatorConfig {
     /// drift), rad: a measured mean heel or trim beyond the model's own by more is real, and the
     /// forecast keeps it less this.
     pub angle_bias_rad: f64,
+    /// The motion sensor's drift: a bias that wanders (first-order Gauss-Markov), its standard
+    /// deviation (translations m, rotations rad) and correlation time, s. What the bias average leaves
+    /// of it widens the band at a forecast's start; what the average holds is how large a roll or
+    /// pitch offset the sensor's bias may make (`rom::spread::heel_split`).
+    pub drift_m: f64,
+    pub drift_rad: f64,
+    pub drift_time_s: f64,
 }
 
 impl Default for EstimatorConfig {
@@ -210,6 +217,9 @@ impl Default for EstimatorConfig {
             reset_samples: 5,
             bias_time_s: 300.0,
             angle_bias_rad: 0.001,
+            drift_m: 0.02,
+            drift_rad: 0.0003,
+            drift_time_s: 600.0,
         }
     }
 }
@@ -852,6 +862,9 @@ pub const BOUNDS: &[Bound] = &[
     positive("link.stale_s", 3600.0, "s"),
     positive("link.window_s", DAY_S, "s"),
     closed("estimator.angle_bias_rad", 0.0, 0.1, "rad"),
+    closed("estimator.drift_m", 0.0, 10.0, "m"),
+    closed("estimator.drift_rad", 0.0, 1.0, "rad"),
+    positive("estimator.drift_time_s", DAY_S, "s"),
     // a terabyte of messages per file at most
     positive("record.rotate_mb", 1.0e6, "MB"),
     positive("record.rotate_s", 30.0 * DAY_S, "s"),
@@ -959,6 +972,9 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("link.stale_s", c.link.stale_s),
         one("link.window_s", c.link.window_s),
         one("estimator.angle_bias_rad", c.estimator.angle_bias_rad),
+        one("estimator.drift_m", c.estimator.drift_m),
+        one("estimator.drift_rad", c.estimator.drift_rad),
+        one("estimator.drift_time_s", c.estimator.drift_time_s),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
         one("simulate.duration_s", s.duration_s),

@@ -119,6 +119,10 @@ pub struct Spec {
     /// DOFs whose bias is estimated (hydrostatic restoring).
     pub restored: [bool; 6],
     pub bias_time_s: f64,
+    /// The sensor's drift per DOF (standard deviation, m or rad) and its correlation time, s: what
+    /// the bias average does not take off is part of a start's error ([`Estimator::start_var`]).
+    pub drift: [f64; 6],
+    pub drift_time_s: f64,
     pub gate_sigma: f64,
     pub reset_samples: usize,
 }
@@ -286,6 +290,10 @@ pub struct Estimator {
     keep_s: f64,
     entries: VecDeque<Entry>,
     bias: RunningMean,
+    /// Running means of the innovations' products per DOF (displacement^2, displacement x velocity,
+    /// velocity^2; over `bias_time_s`): what the filter's prediction actually errs by, its noise
+    /// added ([`Estimator::start_var`]).
+    innovation: [RunningMean; 3],
     /// Refused samples in a row that agree with each other, filtered from the first of them.
     candidate: Vec<Entry>,
     /// The values of the last sample received (taken or not), and how many received in a row
@@ -305,6 +313,7 @@ impl Estimator {
             keep_s,
             entries: VecDeque::new(),
             bias: RunningMean::default(),
+            innovation: Default::default(),
             candidate: vec![],
             last_received: None,
             repeats: 0,
@@ -351,6 +360,77 @@ impl Estimator {
             }
         }
         b
+    }
+
+    /// The variance of the error of the displacement a forecast starting at `t0_s` takes (the bias
+    /// off), per DOF (m^2, rad^2): the filter's at the newest sample up to t0 (the smoother's is
+    /// smaller: a bound), and the sensor's drift the bias average leaves. The filter's is what its
+    /// gain K makes of the error its predictions actually show, (I - K) A (I - K)^T + K R K^T with A
+    /// the innovations' covariance less the noise's R (the innovation is the prediction's error plus
+    /// a noise independent of it): its own variance assumes an acceleration as wide as its bandwidth
+    /// and is far larger than its error on a ship's smooth motion. Until the innovations have been
+    /// averaged over a fifth of `bias_time_s`, the filter's own variance. A first-order
+    /// Gauss-Markov drift of variance s^2 and correlation time tau, averaged over the last T, leaves
+    /// s^2 T / (tau + T) (the average follows the drift less the longer it is; the rest,
+    /// [`Estimator::drift_in_bias_var`], is in the bias taken off); a DOF whose bias is not taken off
+    /// (no restoring, or not yet averaged) keeps all of it. The raw method's is the sensor's noise and
+    /// its drift. None before any sample.
+    pub fn start_var(&self, t0_s: f64) -> Option<[f64; 6]> {
+        let j = self.entries.partition_point(|e| e.time_s <= t0_s);
+        let e = self.entries.get(j.saturating_sub(1))?;
+        let taken = self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s;
+        let span = self.bias.span_s.min(self.spec.bias_time_s);
+        let mut out = [0.0; 6];
+        for (d, o) in out.iter_mut().enumerate() {
+            let est = match self.spec.method {
+                Method::Kalman if self.innovation[0].span_s >= 0.2 * self.spec.bias_time_s => {
+                    self.filtered_error_var(e, d).unwrap_or(e.filtered[d].p[0])
+                }
+                Method::Kalman => e.filtered[d].p[0],
+                Method::Raw => self.spec.noise_x[d] * self.spec.noise_x[d],
+            };
+            let s2 = self.spec.drift[d] * self.spec.drift[d];
+            let drift = if taken && self.spec.restored[d] && span > 0.0 {
+                s2 * span / (self.spec.drift_time_s + span)
+            } else {
+                s2
+            };
+            *o = est + drift;
+        }
+        Some(out)
+    }
+
+    /// The variance of the sensor's drift that the bias average holds, per DOF (m^2, rad^2): s^2 tau /
+    /// (tau + T) for a first-order Gauss-Markov drift averaged over the last T (0 where no bias is
+    /// taken off). The measured mean's offset from the model's holds it: of such an offset, this much
+    /// is the sensor's, not the motion's.
+    pub fn drift_in_bias_var(&self) -> [f64; 6] {
+        let taken = self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s;
+        let span = self.bias.span_s.min(self.spec.bias_time_s);
+        std::array::from_fn(|d| {
+            if taken && self.spec.restored[d] && span > 0.0 {
+                let s2 = self.spec.drift[d] * self.spec.drift[d];
+                s2 * self.spec.drift_time_s / (self.spec.drift_time_s + span)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The displacement error variance of DOF d's filtered estimate at entry `e`, from the actual
+    /// error of the predictions (the innovations less the noise): (I - K) A (I - K)^T + K R K^T.
+    fn filtered_error_var(&self, e: &Entry, d: usize) -> Option<f64> {
+        let (rx, rv) = (self.spec.noise_x[d].powi(2), self.spec.noise_v[d].powi(2));
+        let [pp, pv, vv] = e.predicted[d].p;
+        let [k00, k01, _, _] = times_inverse([pp, pv, pv, vv], [pp + rx, pv, vv + rv])?;
+        let a00 = (self.innovation[0].value[d] - rx).max(0.0);
+        let a11 = (self.innovation[2].value[d] - rv).max(0.0);
+        let bound = (a00 * a11).sqrt();
+        let a01 = self.innovation[1].value[d].clamp(-bound, bound);
+        // row 0 of (I - K): (1 - k00, -k01); of K: (k00, k01)
+        let (i0, i1) = (1.0 - k00, -k01);
+        let v = i0 * i0 * a00 + 2.0 * i0 * i1 * a01 + i1 * i1 * a11 + k00 * k00 * rx + k01 * k01 * rv;
+        v.is_finite().then_some(v.max(0.0))
     }
 
     fn first(&self, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Entry {
@@ -493,6 +573,7 @@ impl Estimator {
         }
         self.entries.clear();
         self.bias = RunningMean::default();
+        self.innovation = Default::default();
         for e in std::mem::take(&mut self.candidate) {
             self.take(e);
         }
@@ -510,6 +591,14 @@ impl Estimator {
             None => 0.0,
         };
         self.bias.add(dt, &e.x, self.spec.bias_time_s);
+        if self.entries.back().is_some() && dt > 0.0 {
+            let n: [[f64; 2]; 6] =
+                std::array::from_fn(|d| [e.x[d] - e.predicted[d].m[0], e.v[d] - e.predicted[d].m[1]]);
+            let products = [[0, 0], [0, 1], [1, 1]];
+            for (m, [a, b]) in self.innovation.iter_mut().zip(products) {
+                m.add(dt, &std::array::from_fn(|d| n[d][a] * n[d][b]), self.spec.bias_time_s);
+            }
+        }
         let t = e.time_s;
         self.entries.push_back(e);
         while let Some(f) = self.entries.front() {
@@ -659,6 +748,8 @@ mod tests {
             bounds: Bounds::from_system(&nalgebra::Matrix6::from_diagonal_element(1e6), 9.81, 2.0, 0.2),
             restored: [false, false, true, true, true, false],
             bias_time_s: 100.0,
+            drift: [0.0; 6],
+            drift_time_s: 600.0,
             gate_sigma: 5.0,
             reset_samples: 5,
         }
@@ -791,6 +882,49 @@ mod tests {
             kalman.1,
             measured.1
         );
+    }
+
+    #[test]
+    fn the_start_s_variance_is_the_error_the_filter_makes_as_its_innovations_show_it() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut spec = spec(Method::Kalman);
+        spec.drift = [0.0, 0.0, 0.02, 0.0, 0.0, 0.0];
+        spec.drift_time_s = 600.0;
+        let mut e = Estimator::new(spec, 300.0);
+        let (mut square, mut count, mut own, mut start) = (0.0, 0.0, 0.0, 0.0);
+        for k in 0..=4000 {
+            let t = k as f64 * 0.1;
+            let (mut x, mut v) = wave(t);
+            x[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            v[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            e.push(t, x, v).unwrap();
+            if t < 30.0 {
+                // before the innovations have been averaged over a fifth of bias_time_s: the
+                // filter's own variance, and all of the drift (no bias taken off yet)
+                if k > 1 && t < 19.0 {
+                    let f = e.entries.back().unwrap().filtered[2].p[0];
+                    assert_eq!(e.start_var(t).unwrap()[2], f + 4e-4);
+                }
+                continue;
+            }
+            let newest = e.entries.back().unwrap().filtered[2];
+            square += (newest.m[0] - wave(t).0[2]).powi(2);
+            own += newest.p[0];
+            // the drift the bias average leaves: 4e-4 x 100 / (600 + 100)
+            start += e.start_var(t).unwrap()[2] - 4e-4 / 7.0;
+            count += 1.0;
+        }
+        let (actual, own, start) = (square / count, own / count, start / count);
+        // the filter's own variance takes the 0.6 rad/s wave for an acceleration as wide as its
+        // bandwidth: more than the error it makes; the innovations tell that error
+        assert!(own > actual, "own {own}, actual {actual}");
+        assert!(
+            start > 0.9 * actual && start < 1.1 * actual,
+            "start {start}, actual {actual}, own {own}"
+        );
+        // the rest of the drift is in the bias taken off
+        assert!((e.drift_in_bias_var()[2] - 4e-4 * 6.0 / 7.0).abs() < 1e-12);
     }
 
     #[test]

@@ -124,6 +124,11 @@ pub struct Job {
     /// The model error of each series against lead, as a fraction of its motion
     /// ([`spread::ModelError`]).
     model_error: spread::ModelErrorCurve,
+    /// Per series, the variance of the start's random error and its expected error
+    /// ([`spread::SpreadOptions`]; the estimator's `start_var` and, for roll and pitch,
+    /// [`spread::heel_split`]).
+    start_var: Vec<f64>,
+    start_offset: Vec<f64>,
     /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
     track: Option<Track>,
     header: ForecastHeader,
@@ -141,6 +146,9 @@ pub struct Done {
     /// Each series' motion standard deviation by the band's model, and the model error the band took.
     pub motion_sigma: Vec<f64>,
     pub model_error: spread::ModelErrorCurve,
+    /// Per series, the variance of the start's random error (the estimate's error: the checks
+    /// against later estimates carry as much).
+    pub start_var: Vec<f64>,
     /// The forecast may teach the model error: its waves were trusted and its band known (a forecast
     /// with no trusted span teaches all the same: its error is the model's).
     pub teaches: bool,
@@ -161,6 +169,10 @@ pub const MEASURED_MEAN_DOFS: [usize; 2] = [3, 4];
 fn beyond(x: f64, bound: f64) -> f64 {
     x.signum() * (x.abs() - bound).max(0.0)
 }
+
+/// How many `bias_time_s` the mean square of the measured mean's offset is taken over
+/// (`Engine::heel_square`): several correlation times of an MRU's drift (600 s) at the default 300 s.
+pub const HEEL_MEMORY_BIAS_TIMES: f64 = 3.0;
 
 /// A forecast's leads from this one on are settled (past a roll's decay, 1 / (zeta w_n) = 47 s at 5 %
 /// of critical and 0.43 rad/s): their mean is the model's own mean in waves, s.
@@ -297,6 +309,8 @@ impl Computer {
         let opts = SpreadOptions {
             model_error: job.model_error.clone(),
             trusted_nrmse: self.trusted_nrmse,
+            start_var: job.start_var.clone(),
+            start_offset: job.start_offset.clone(),
         };
         let result = result.map(|(values, steps, dropped, quasi_static)| {
             let spread = self.table.as_ref().map(|table| {
@@ -352,6 +366,7 @@ impl Computer {
                     teaches: job.trustworthy && !motion_sigma.is_empty(),
                     motion_sigma,
                     model_error: job.model_error,
+                    start_var: job.start_var,
                 }
             }
             Err(e) => Done {
@@ -362,6 +377,7 @@ impl Computer {
                 dropped_wave_share: 0.0,
                 motion_sigma: vec![],
                 model_error: job.model_error,
+                start_var: job.start_var,
                 teaches: false,
             },
         }
@@ -573,6 +589,8 @@ pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeMode
         ),
         restored: [false; 6],
         bias_time_s: e.bias_time_s,
+        drift: [e.drift_m, e.drift_m, e.drift_m, e.drift_rad, e.drift_rad, e.drift_rad],
+        drift_time_s: e.drift_time_s,
         gate_sigma: e.gate_sigma,
         reset_samples: e.reset_samples as usize,
     };
@@ -648,6 +666,11 @@ pub struct Engine {
     /// was last learnt (`learn_model_mean`).
     model_mean: Vec<estimator::RunningMean>,
     model_mean_time_s: Option<f64>,
+    /// Per vessel, the running mean square of roll's and pitch's measured mean offset from the
+    /// model's (over [`HEEL_MEMORY_BIAS_TIMES`] `bias_time_s`), and when it was last taken in: what
+    /// the sensor's drift does not explain of it is heel ([`spread::heel_split`]).
+    heel_square: Vec<estimator::RunningMean>,
+    heel_time_s: Option<f64>,
     bias_time_s: f64,
     /// `estimator.angle_bias_rad`.
     angle_bias_rad: f64,
@@ -720,6 +743,8 @@ impl Engine {
             model_error_logged: 0,
             model_mean: vec![Default::default(); n_bodies],
             model_mean_time_s: None,
+            heel_square: vec![Default::default(); n_bodies],
+            heel_time_s: None,
             job_offset: vec![[0.0; 6]; n_bodies],
             job_unknown: vec![false; n_bodies],
             bias_time_s: cfg.estimator.bias_time_s,
@@ -1005,6 +1030,15 @@ impl Engine {
             let mut velocities = vec![vec![0.0; self.n_active]; n_hist];
             let mut known_history = n_hist;
             let mut offset = vec![[0.0; 6]; n_bodies];
+            // the start's error per series: a vessel without fresh motion is bounded apart
+            // (`unknown_start`), so its share here is the sensor's noise
+            let mut start_var: Vec<f64> = self.model_error.noise_var().to_vec();
+            let mut start_offset = vec![0.0; 6 * n_bodies];
+            let heel_dt = match self.heel_time_s {
+                Some(t) => (t0 - t).max(0.0),
+                None => 0.0,
+            };
+            self.heel_time_s = Some(t0);
             let mut ok = true;
             for b in 0..n_bodies {
                 if !motion_fresh[b] {
@@ -1051,19 +1085,56 @@ impl Engine {
                         }
                     }
                 }
+                if let Some(v) = self.hist[b].start_var(t0) {
+                    start_var[6 * b..6 * b + 6].copy_from_slice(&v);
+                }
+                // roll and pitch: what the forecast leaves out of the measured mean's offset from the
+                // model's (within angle_bias_rad) is the sensor's bias or a heel, which no sample
+                // tells apart; the band holds either, as likely as the sensor's drift and the
+                // offsets seen so far make them (`spread::heel_split`)
+                let held = self.hist[b].drift_in_bias_var();
+                let mut square = [f64::NAN; 6];
+                for d in MEASURED_MEAN_DOFS {
+                    if bias[d] != 0.0 {
+                        let m = bias[d] - self.model_mean[b].value[d];
+                        square[d] = m * m;
+                        let heel_var = if self.heel_square[b].span_s > 0.0 {
+                            (self.heel_square[b].value[d] - held[d]).max(0.0)
+                        } else {
+                            f64::INFINITY
+                        };
+                        let (mean, var) = spread::heel_split(m, m - offset[b][d], held[d], heel_var);
+                        start_offset[6 * b + d] = mean;
+                        start_var[6 * b + d] += var;
+                    }
+                }
+                self.heel_square[b].add(heel_dt, &square, HEEL_MEMORY_BIAS_TIMES * self.bias_time_s);
             }
             if ok {
-                // past forecasts against the motion that followed them, as measured: with what the
-                // estimator takes for a sensor's bias (a forecast settles to the model's equilibrium, a
-                // moored vessel's static heel included, whatever its start)
+                // past forecasts against the motion that followed them, as measured, with the sensor's
+                // bias off as the forecast takes it: about the model's own mean where the measured
+                // mean is taken for the sensor's (heave's drift; roll and pitch within the bias the
+                // sensor may have: how much of that may be heel is in the band at the start,
+                // `spread::heel_split`), with the measured mean where roll or pitch keeps a heel
+                // (gravity-referenced: part of what the forecast leaves out of it as bias may be
+                // heel, and a forecast settles to the model's equilibrium whatever its start)
                 let hist = &self.hist;
+                let model_mean = &self.model_mean;
+                let angle_bias_rad = self.angle_bias_rad;
                 self.model_error.observe(t0, |t| {
                     let mut x = vec![0.0; 6 * n_bodies];
                     for (b, h) in hist.iter().enumerate() {
                         let r = h.resample(t, dt, 0, cfg.max_gap_s)?;
                         let bias = h.bias();
                         for d in 0..6 {
-                            x[6 * b + d] = r.x0[d] + bias[d];
+                            let mean = model_mean[b].value[d];
+                            let heel = MEASURED_MEAN_DOFS.contains(&d) && beyond(bias[d] - mean, angle_bias_rad) != 0.0;
+                            x[6 * b + d] = r.x0[d]
+                                + match (bias[d] != 0.0, heel) {
+                                    (false, _) => 0.0,
+                                    (true, true) => bias[d],
+                                    (true, false) => mean,
+                                };
                         }
                     }
                     Some(x)
@@ -1186,6 +1257,8 @@ impl Engine {
                     known_leads,
                     trustworthy,
                     model_error: self.model_error.curve(),
+                    start_var,
+                    start_offset,
                     track,
                     header,
                 });
@@ -1232,6 +1305,7 @@ impl Engine {
                         (&values[..n], &values[n..]),
                         &d.motion_sigma,
                         &d.model_error,
+                        &d.start_var,
                     );
                 }
                 self.last_horizon = header.horizon_s;
