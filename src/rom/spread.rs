@@ -499,9 +499,9 @@ fn after_start(lead_s: f64) -> f64 {
 /// the sensor's bias: the measured offset is heel H plus the sensor's bias average S, independent,
 /// of variances `heel_var` (infinite: nothing known of it, all taken for heel) and `bias_var` (the
 /// sensor's drift the average holds). The start errs by left - S (truth less forecast); given the
-/// measured offset, S is normal about k measured with variance k heel_var, k = bias_var / (bias_var
-/// + heel_var). So (left - k measured, k heel_var); (left - measured, 0) where no heel is known, and
-/// (left, bias_var) where nothing is.
+/// measured offset, S is normal about k measured with variance k heel_var, where k is bias_var over
+/// (bias_var + heel_var). So (left - k measured, k heel_var); (left - measured, 0) where no heel is
+/// known, and (left, bias_var) where nothing is.
 pub fn heel_split(measured: f64, left: f64, bias_var: f64, heel_var: f64) -> (f64, f64) {
     let bias_var = bias_var.max(0.0);
     if !(measured.is_finite() && left.is_finite() && bias_var.is_finite()) || heel_var.is_nan() {
