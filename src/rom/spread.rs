@@ -391,8 +391,9 @@ struct Pending {
     /// The band before its learnt scale, with the check's own error: what a check's error is
     /// measured in.
     raw_sigma: Vec<Vec<f64>>,
-    /// Per series, the variance of the error of the estimates the forecast is checked against (its
-    /// start's: `SpreadOptions::start_var`; the sensor's noise where not given).
+    /// Per series, the variance of what the estimate the forecast started from and the one it is
+    /// checked against differ by beside the motion (the estimator's own error; the sensor's noise
+    /// where not given).
     check_var: Vec<f64>,
 }
 
@@ -656,8 +657,10 @@ impl ModelError {
     }
 
     /// A forecast issued at `issue_s` (values and standard deviations series-major, `steps + 1` each,
-    /// step `dt_s`), each series' motion standard deviation by the model, and the model error it was
-    /// made with.
+    /// step `dt_s`), each series' motion standard deviation by the model, the model error it was
+    /// made with, each series' start error variance (`start_var`, the band's floor: as
+    /// [`SpreadOptions::start_var`]) and estimate error variance (`check_var`: what a check against a
+    /// later estimate differs by beside the motion); missing, the sensor's noise.
     pub fn record(
         &mut self,
         issue_s: f64,
@@ -666,6 +669,7 @@ impl ModelError {
         model_motion_sigma: &[f64],
         used: &ModelErrorCurve,
         start_var: &[f64],
+        check_var: &[f64],
     ) {
         let (values, sigma) = spread;
         let ns = self.n_series;
@@ -677,15 +681,14 @@ impl ModelError {
             return;
         }
         let n = values.len() / ns;
-        let check_var: Vec<f64> = (0..ns)
-            .map(|i| {
-                start_var
-                    .get(i)
-                    .copied()
-                    .filter(|v| v.is_finite() && *v >= 0.0)
-                    .unwrap_or(self.noise_var[i])
-            })
-            .collect();
+        let given = |v: &[f64], i: usize| {
+            v.get(i)
+                .copied()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .unwrap_or(self.noise_var[i])
+        };
+        let check_var: Vec<f64> = (0..ns).map(|i| given(check_var, i)).collect();
+        let floor_var: Vec<f64> = (0..ns).map(|i| given(start_var, i)).collect();
         let mut p = Pending {
             issue_s,
             dt_s,
@@ -715,9 +718,10 @@ impl ModelError {
             p.unknown_var.push(
                 (0..ns)
                     .map(|i| {
-                        // the learnt model error, or the start's error where the band is floored at it
+                        // the learnt model error, or the band's floor (the start's error: a band on it
+                        // is taken for no unknown waves)
                         let learnt = used.learnt_at(i, lead, model_motion_sigma[i] * model_motion_sigma[i]);
-                        let floor = learnt.max(p.check_var[i] / used.scale_at(i, lead).powi(2));
+                        let floor = learnt.max(floor_var[i] / used.scale_at(i, lead).powi(2));
                         (raw[i].powi(2) - floor).max(0.0)
                     })
                     .collect(),
@@ -755,7 +759,7 @@ impl ModelError {
                 // start's (`start_sigma`), and those checks learn only the motion's variance
                 for (i, xi) in x.iter().enumerate().filter(|_| j > 0) {
                     let e2 = (xi - p.values[j][i]).powi(2);
-                    // the estimate checked against errs by as much as the start did
+                    // the estimate checked against errs by as much as the start's did
                     let noise = p.check_var[i];
                     let explained = p.unknown_var[j][i] + noise;
                     self.excess[j][i] += w * (e2 - explained - self.excess[j][i]);
@@ -844,7 +848,7 @@ mod tests {
         let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.7 } else { -0.7 };
         for j in 0..200 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[]);
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         assert!(m.checks()[..5].iter().all(|c| *c >= CHECK_MIN), "{:?}", m.checks());
@@ -865,7 +869,7 @@ mod tests {
         assert!((c.at(0, 37.5, 1.0) - 0.5 * (0.24 + (0.33f64 * 1.25).powi(2))).abs() < 0.01);
         // a motion that is not there, or not finite, is no check
         let before = m.checks().to_vec();
-        m.record(300.0, dt, (&values, &sigma), &[1.0], &prior, &[]);
+        m.record(300.0, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
         m.observe(400.0, |_| Some(vec![f64::NAN]));
         m.observe(400.0, |_| None);
         assert_eq!(m.checks(), &before[..]);
@@ -883,7 +887,7 @@ mod tests {
         let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.02 } else { -0.02 };
         for j in 0..200 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1e-3], &prior, &[]);
+            m.record(t, dt, (&values, &sigma), &[1e-3], &prior, &[], &[]);
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         let c = m.curve();
@@ -1003,7 +1007,7 @@ mod tests {
         };
         for j in 0..700 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[]);
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         let c = m.curve();
@@ -1018,7 +1022,7 @@ mod tests {
         let mut again = ModelError::new(0.0, vec![0.0]);
         for j in 0..700 {
             let t = j as f64;
-            again.record(t, dt, (&values, &scaled), &[1.0], &c, &[]);
+            again.record(t, dt, (&values, &scaled), &[1.0], &c, &[], &[]);
             again.observe(t, |at| Some(vec![truth(at)]));
         }
         assert!((again.curve().scale[0][2] - expect).abs() < 1e-9);

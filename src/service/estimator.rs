@@ -376,19 +376,12 @@ impl Estimator {
     /// (no restoring, or not yet averaged) keeps all of it. The raw method's is the sensor's noise and
     /// its drift. None before any sample.
     pub fn start_var(&self, t0_s: f64) -> Option<[f64; 6]> {
-        let j = self.entries.partition_point(|e| e.time_s <= t0_s);
-        let e = self.entries.get(j.saturating_sub(1))?;
+        let estimate = self.estimate_var(t0_s)?;
         let taken = self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s;
         let span = self.bias.span_s.min(self.spec.bias_time_s);
         let mut out = [0.0; 6];
         for (d, o) in out.iter_mut().enumerate() {
-            let est = match self.spec.method {
-                Method::Kalman if self.innovation[0].span_s >= 0.2 * self.spec.bias_time_s => {
-                    self.filtered_error_var(e, d).unwrap_or(e.filtered[d].p[0])
-                }
-                Method::Kalman => e.filtered[d].p[0],
-                Method::Raw => self.spec.noise_x[d] * self.spec.noise_x[d],
-            };
+            let est = estimate[d];
             let s2 = self.spec.drift[d] * self.spec.drift[d];
             let drift = if taken && self.spec.restored[d] && span > 0.0 {
                 s2 * span / (self.spec.drift_time_s + span)
@@ -398,6 +391,22 @@ impl Estimator {
             *o = est + drift;
         }
         Some(out)
+    }
+
+    /// The estimate's own error variance at `t0_s` per DOF (m^2, rad^2; [`Estimator::start_var`]
+    /// without the drift): the filter's as its innovations show it. Between a forecast and its check
+    /// at a later lead this is what the two estimates differ by beside the motion; the drift, slow,
+    /// they share. None before any sample.
+    pub fn estimate_var(&self, t0_s: f64) -> Option<[f64; 6]> {
+        let j = self.entries.partition_point(|e| e.time_s <= t0_s);
+        let e = self.entries.get(j.saturating_sub(1))?;
+        Some(std::array::from_fn(|d| match self.spec.method {
+            Method::Kalman if self.innovation[0].span_s >= 0.2 * self.spec.bias_time_s => {
+                self.filtered_error_var(e, d).unwrap_or(e.filtered[d].p[0])
+            }
+            Method::Kalman => e.filtered[d].p[0],
+            Method::Raw => self.spec.noise_x[d] * self.spec.noise_x[d],
+        }))
     }
 
     /// The variance of the sensor's drift that the bias average holds, per DOF (m^2, rad^2): s^2 tau /

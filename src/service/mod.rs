@@ -129,6 +129,8 @@ pub struct Job {
     /// [`spread::heel_split`]).
     start_var: Vec<f64>,
     start_offset: Vec<f64>,
+    /// Per series, the estimate's own error variance (`estimator::Estimator::estimate_var`).
+    check_var: Vec<f64>,
     /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
     track: Option<Track>,
     header: ForecastHeader,
@@ -146,9 +148,11 @@ pub struct Done {
     /// Each series' motion standard deviation by the band's model, and the model error the band took.
     pub motion_sigma: Vec<f64>,
     pub model_error: spread::ModelErrorCurve,
-    /// Per series, the variance of the start's random error (the estimate's error: the checks
-    /// against later estimates carry as much).
+    /// Per series, the variance of the start's random error (the band's floor) and of the estimate's
+    /// own error (the filter's: what a check against a later estimate differs by beside the motion;
+    /// the sensor's drift, slow, the two share).
     pub start_var: Vec<f64>,
+    pub check_var: Vec<f64>,
     /// The forecast may teach the model error: its waves were trusted and its band known (a forecast
     /// with no trusted span teaches all the same: its error is the model's).
     pub teaches: bool,
@@ -367,6 +371,7 @@ impl Computer {
                     motion_sigma,
                     model_error: job.model_error,
                     start_var: job.start_var,
+                    check_var: job.check_var,
                 }
             }
             Err(e) => Done {
@@ -378,6 +383,7 @@ impl Computer {
                 motion_sigma: vec![],
                 model_error: job.model_error,
                 start_var: job.start_var,
+                check_var: job.check_var,
                 teaches: false,
             },
         }
@@ -1034,6 +1040,7 @@ impl Engine {
             // (`unknown_start`), so its share here is the sensor's noise
             let mut start_var: Vec<f64> = self.model_error.noise_var().to_vec();
             let mut start_offset = vec![0.0; 6 * n_bodies];
+            let mut check_var = start_var.clone();
             let heel_dt = match self.heel_time_s {
                 Some(t) => (t0 - t).max(0.0),
                 None => 0.0,
@@ -1087,6 +1094,9 @@ impl Engine {
                 }
                 if let Some(v) = self.hist[b].start_var(t0) {
                     start_var[6 * b..6 * b + 6].copy_from_slice(&v);
+                }
+                if let Some(v) = self.hist[b].estimate_var(t0) {
+                    check_var[6 * b..6 * b + 6].copy_from_slice(&v);
                 }
                 // roll and pitch: what the forecast leaves out of the measured mean's offset from the
                 // model's (within angle_bias_rad) is the sensor's bias or a heel, which no sample
@@ -1259,6 +1269,7 @@ impl Engine {
                     model_error: self.model_error.curve(),
                     start_var,
                     start_offset,
+                    check_var,
                     track,
                     header,
                 });
@@ -1306,6 +1317,7 @@ impl Engine {
                         &d.motion_sigma,
                         &d.model_error,
                         &d.start_var,
+                        &d.check_var,
                     );
                 }
                 self.last_horizon = header.horizon_s;
