@@ -658,9 +658,9 @@ impl ModelError {
 
     /// A forecast issued at `issue_s` (values and standard deviations series-major, `steps + 1` each,
     /// step `dt_s`), each series' motion standard deviation by the model, the model error it was
-    /// made with, each series' start error variance (`start_var`, the band's floor: as
-    /// [`SpreadOptions::start_var`]) and estimate error variance (`check_var`: what a check against a
-    /// later estimate differs by beside the motion); missing, the sensor's noise.
+    /// made with, and `errors`: each series' start error variance (the band's floor: as
+    /// [`SpreadOptions::start_var`]) and estimate error variance (what a check against a later
+    /// estimate differs by beside the motion); missing, the sensor's noise.
     pub fn record(
         &mut self,
         issue_s: f64,
@@ -668,10 +668,10 @@ impl ModelError {
         spread: (&[f64], &[f64]),
         model_motion_sigma: &[f64],
         used: &ModelErrorCurve,
-        start_var: &[f64],
-        check_var: &[f64],
+        errors: (&[f64], &[f64]),
     ) {
         let (values, sigma) = spread;
+        let (start_var, check_var) = errors;
         let ns = self.n_series;
         if !(dt_s > 0.0 && issue_s.is_finite())
             || model_motion_sigma.len() != ns
@@ -848,7 +848,7 @@ mod tests {
         let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.7 } else { -0.7 };
         for j in 0..200 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior, (&[], &[]));
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         assert!(m.checks()[..5].iter().all(|c| *c >= CHECK_MIN), "{:?}", m.checks());
@@ -869,7 +869,7 @@ mod tests {
         assert!((c.at(0, 37.5, 1.0) - 0.5 * (0.24 + (0.33f64 * 1.25).powi(2))).abs() < 0.01);
         // a motion that is not there, or not finite, is no check
         let before = m.checks().to_vec();
-        m.record(300.0, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
+        m.record(300.0, dt, (&values, &sigma), &[1.0], &prior, (&[], &[]));
         m.observe(400.0, |_| Some(vec![f64::NAN]));
         m.observe(400.0, |_| None);
         assert_eq!(m.checks(), &before[..]);
@@ -887,7 +887,7 @@ mod tests {
         let truth = |t: f64| if t.round() as i64 % 2 == 0 { 0.02 } else { -0.02 };
         for j in 0..200 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1e-3], &prior, &[], &[]);
+            m.record(t, dt, (&values, &sigma), &[1e-3], &prior, (&[], &[]));
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         let c = m.curve();
@@ -1007,7 +1007,7 @@ mod tests {
         };
         for j in 0..700 {
             let t = j as f64;
-            m.record(t, dt, (&values, &sigma), &[1.0], &prior, &[], &[]);
+            m.record(t, dt, (&values, &sigma), &[1.0], &prior, (&[], &[]));
             m.observe(t, |at| Some(vec![truth(at)]));
         }
         let c = m.curve();
@@ -1022,7 +1022,7 @@ mod tests {
         let mut again = ModelError::new(0.0, vec![0.0]);
         for j in 0..700 {
             let t = j as f64;
-            again.record(t, dt, (&values, &scaled), &[1.0], &c, &[], &[]);
+            again.record(t, dt, (&values, &scaled), &[1.0], &c, (&[], &[]));
             again.observe(t, |at| Some(vec![truth(at)]));
         }
         assert!((again.curve().scale[0][2] - expect).abs() < 1e-9);

@@ -1316,8 +1316,7 @@ impl Engine {
                         (&values[..n], &values[n..]),
                         &d.motion_sigma,
                         &d.model_error,
-                        &d.start_var,
-                        &d.check_var,
+                        (&d.start_var, &d.check_var),
                     );
                 }
                 self.last_horizon = header.horizon_s;
