@@ -519,6 +519,20 @@ pub fn heel_split(measured: f64, left: f64, bias_var: f64, heel_var: f64) -> (f6
     (left - k * measured, k * heel_var.max(0.0))
 }
 
+/// The bracket [lo, hi] around where `below` turns false, halved `steps` times (`below` true at lo,
+/// false at hi: an increasing function under its target).
+fn bisect(mut lo: f64, mut hi: f64, steps: usize, below: impl Fn(f64) -> bool) -> (f64, f64) {
+    for _ in 0..steps {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, hi)
+}
+
 /// The standard deviation of a 90 % band at a forecast's start whose error is `offset_m` (m or rad)
 /// plus a normal error of variance `var`: such that |offset + N(0, var)| falls inside it
 /// [`BAND_QUANTILE`] of the time (`var` alone: its own standard deviation).
@@ -534,15 +548,7 @@ pub fn start_sigma(offset: f64, var: f64) -> f64 {
         return e / Z90;
     }
     let covered = |h: f64| normal_cdf((h - e) / s) - normal_cdf((-h - e) / s);
-    let (mut lo, mut hi) = (0.0, e + 5.0 * s);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if covered(mid) < BAND_QUANTILE {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    let (_, hi) = bisect(0.0, e + 5.0 * s, 60, |h| covered(h) < BAND_QUANTILE);
     (hi / Z90).max(s)
 }
 
@@ -705,7 +711,7 @@ impl ModelError {
             }
             p.values.push((0..ns).map(|i| values[i * n + k]).collect());
             // the band as published is the unscaled one times the scale it was made with (at the
-            // check leads past 0; at lead 0 it is the start's, and its checks learn only offsets)
+            // check leads past 0; at lead 0 it is the start's, and its checks learn no model error)
             let raw: Vec<f64> = (0..ns)
                 .map(|i| {
                     if lead > 0.0 {
@@ -806,15 +812,7 @@ pub fn exceedance(mean: f64, sigma: f64, limit: f64) -> f64 {
 /// deviations (1.645 for 0.9), by bisection on [`normal_cdf`].
 pub fn band_z(probability: f64) -> f64 {
     let target = 0.5 + 0.5 * probability.clamp(0.0, 1.0 - 1e-12);
-    let (mut lo, mut hi) = (0.0, 10.0);
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if normal_cdf(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    let (lo, hi) = bisect(0.0, 10.0, 80, |z| normal_cdf(z) < target);
     0.5 * (lo + hi)
 }
 

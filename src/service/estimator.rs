@@ -350,16 +350,13 @@ impl Estimator {
     /// The bias estimate taken off the initial displacement (0 for DOFs without restoring, and until
     /// the average spans a fifth of `bias_time_s`).
     pub fn bias(&self) -> [f64; 6] {
-        if self.spec.method == Method::Raw || self.bias.span_s < 0.2 * self.spec.bias_time_s {
-            return [0.0; 6];
-        }
-        let mut b = self.bias.value;
-        for (d, bd) in b.iter_mut().enumerate() {
-            if !self.spec.restored[d] {
-                *bd = 0.0;
-            }
-        }
-        b
+        std::array::from_fn(|d| if self.bias_taken(d) { self.bias.value[d] } else { 0.0 })
+    }
+
+    /// Whether DOF d's bias is taken off: it has restoring, and the Kalman method's average spans a
+    /// fifth of `bias_time_s`.
+    fn bias_taken(&self, d: usize) -> bool {
+        self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s && self.spec.restored[d]
     }
 
     /// The variance of the error of the displacement a forecast starting at `t0_s` takes (the bias
@@ -377,20 +374,11 @@ impl Estimator {
     /// its drift. None before any sample.
     pub fn start_var(&self, t0_s: f64) -> Option<[f64; 6]> {
         let estimate = self.estimate_var(t0_s)?;
-        let taken = self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s;
-        let span = self.bias.span_s.min(self.spec.bias_time_s);
-        let mut out = [0.0; 6];
-        for (d, o) in out.iter_mut().enumerate() {
-            let est = estimate[d];
+        let held = self.drift_in_bias_var();
+        Some(std::array::from_fn(|d| {
             let s2 = self.spec.drift[d] * self.spec.drift[d];
-            let drift = if taken && self.spec.restored[d] && span > 0.0 {
-                s2 * span / (self.spec.drift_time_s + span)
-            } else {
-                s2
-            };
-            *o = est + drift;
-        }
-        Some(out)
+            estimate[d] + (s2 - held[d]).max(0.0)
+        }))
     }
 
     /// The estimate's own error variance at `t0_s` per DOF (m^2, rad^2; [`Estimator::start_var`]
@@ -414,10 +402,9 @@ impl Estimator {
     /// taken off). The measured mean's offset from the model's holds it: of such an offset, this much
     /// is the sensor's, not the motion's.
     pub fn drift_in_bias_var(&self) -> [f64; 6] {
-        let taken = self.spec.method == Method::Kalman && self.bias.span_s >= 0.2 * self.spec.bias_time_s;
         let span = self.bias.span_s.min(self.spec.bias_time_s);
         std::array::from_fn(|d| {
-            if taken && self.spec.restored[d] && span > 0.0 {
+            if self.bias_taken(d) && span > 0.0 {
                 let s2 = self.spec.drift[d] * self.spec.drift[d];
                 s2 * self.spec.drift_time_s / (self.spec.drift_time_s + span)
             } else {
@@ -774,6 +761,15 @@ mod tests {
         (x, v)
     }
 
+    /// [`wave`] as a sensor reads it: heave's displacement and velocity with uniform noise of
+    /// standard deviation 0.01.
+    fn noisy_wave(t: f64, rng: &mut impl rand::Rng) -> ([f64; 6], [f64; 6]) {
+        let (mut x, mut v) = wave(t);
+        x[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+        v[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+        (x, v)
+    }
+
     fn fed(method: Method, until_s: f64, skip: impl Fn(f64) -> bool) -> Estimator {
         let mut e = Estimator::new(spec(method), 300.0);
         for k in 0..=(until_s * 10.0) as usize {
@@ -853,15 +849,13 @@ mod tests {
 
     #[test]
     fn the_smoother_takes_noise_out_of_the_displacement() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let mut e = Estimator::new(spec(Method::Kalman), 300.0);
         let mut raw = Estimator::new(spec(Method::Raw), 300.0);
         for k in 0..=600 {
             let t = k as f64 * 0.1;
-            let (mut x, mut v) = wave(t);
-            x[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
-            v[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            let (x, v) = noisy_wave(t, &mut rng);
             e.push(t, x, v).unwrap();
             raw.push(t, x, v).unwrap();
         }
@@ -895,7 +889,7 @@ mod tests {
 
     #[test]
     fn the_start_s_variance_is_the_error_the_filter_makes_as_its_innovations_show_it() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let mut spec = spec(Method::Kalman);
         spec.drift = [0.0, 0.0, 0.02, 0.0, 0.0, 0.0];
@@ -904,9 +898,7 @@ mod tests {
         let (mut square, mut count, mut own, mut start) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..=4000 {
             let t = k as f64 * 0.1;
-            let (mut x, mut v) = wave(t);
-            x[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
-            v[2] += 0.01 * (rng.random::<f64>() - 0.5) * 12f64.sqrt();
+            let (x, v) = noisy_wave(t, &mut rng);
             e.push(t, x, v).unwrap();
             if t < 30.0 {
                 // before the innovations have been averaged over a fifth of bias_time_s: the
