@@ -51,6 +51,23 @@ pub const STALL_REPEATS: usize = 2;
 /// In the bias average a sample counts for the time since the one before, at most this, s.
 pub const BIAS_MAX_INTERVAL_S: f64 = 1.0;
 
+/// Half the window of the centred average that tells, in hindsight, the sensor's offset at a past
+/// instant, s: a Hann window of +-60 s passes under 1e-4 of a 20 s swell's amplitude, and a drift of
+/// correlation time 10 min changes by a few percent of its spread across it.
+pub const HINDSIGHT_HALF_WINDOW_S: f64 = 60.0;
+/// Half the span of the quadratic fit that tells, in hindsight, the motion at that instant without
+/// the sensor's noise, s: +-1 s holds 21 samples at 10 Hz (the noise falls to a third) and a wave of
+/// 6 s period is still a parabola to within a millimetre per metre over it.
+pub const HINDSIGHT_FIT_HALF_S: f64 = 1.0;
+/// A hindsight check of the start opens this often, s.
+pub const HINDSIGHT_EVERY_S: f64 = 10.0;
+/// The configured figure ([`Estimator::start_var`]'s prior) weighs as much as this many
+/// `bias_time_s` of hindsight checks: within the half hour the sensor's own record outweighs it.
+pub const HINDSIGHT_PRIOR_BIAS_TIMES: f64 = 1.0;
+/// The hindsight checks are averaged over this many `drift_time_s` (a drift that changes character
+/// is followed).
+pub const HINDSIGHT_MEMORY_DRIFT_TIMES: f64 = 4.0;
+
 /// How a vessel's samples become its state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -118,6 +135,9 @@ pub struct Spec {
     pub bounds: Bounds,
     /// DOFs whose bias is estimated (hydrostatic restoring).
     pub restored: [bool; 6],
+    /// DOFs whose start's error is learned in hindsight ([`Estimator::start_var`]): restored, and
+    /// their measured mean the sensor's alone (heave; roll and pitch may heel).
+    pub learned: [bool; 6],
     pub bias_time_s: f64,
     /// The sensor's drift per DOF (standard deviation, m or rad) and its correlation time, s: what
     /// the bias average does not take off is part of a start's error ([`Estimator::start_var`]).
@@ -282,6 +302,82 @@ impl RunningMean {
     }
 }
 
+/// A hindsight check of the start at one instant ([`Estimator::start_var`]): the Hann-weighted sums
+/// of the samples within [`HINDSIGHT_HALF_WINDOW_S`] of it, the sums of a quadratic fit to those
+/// within [`HINDSIGHT_FIT_HALF_S`], and the start the estimator took at the first sample from it.
+#[derive(Debug, Clone)]
+struct Check {
+    centre_s: f64,
+    weight: f64,
+    weighted: [f64; 6],
+    /// sum u^k (k = 0..4) and sum x u^k (k = 0..2) over the fit's samples, u = t - centre
+    powers: [f64; 5],
+    moments: [[f64; 3]; 6],
+    /// (u of the sample, its start less the bias, whether each DOF's bias was taken off there)
+    start: Option<(f64, [f64; 6], [bool; 6])>,
+}
+
+impl Check {
+    fn new(centre_s: f64) -> Check {
+        Check {
+            centre_s,
+            weight: 0.0,
+            weighted: [0.0; 6],
+            powers: [0.0; 5],
+            moments: [[0.0; 3]; 6],
+            start: None,
+        }
+    }
+
+    fn add(&mut self, t: f64, dt_s: f64, x: &[f64; 6]) {
+        let u = t - self.centre_s;
+        if u.abs() < HINDSIGHT_HALF_WINDOW_S {
+            let w = (std::f64::consts::FRAC_PI_2 * u / HINDSIGHT_HALF_WINDOW_S).cos().powi(2) * dt_s;
+            self.weight += w;
+            for (s, xd) in self.weighted.iter_mut().zip(x) {
+                *s += w * xd;
+            }
+        }
+        if u.abs() <= HINDSIGHT_FIT_HALF_S {
+            for (k, p) in self.powers.iter_mut().enumerate() {
+                *p += u.powi(k as i32);
+            }
+            for (m, xd) in self.moments.iter_mut().zip(x) {
+                for (k, mk) in m.iter_mut().enumerate() {
+                    *mk += xd * u.powi(k as i32);
+                }
+            }
+        }
+    }
+
+    /// Per DOF, the square of the start's error less the fit's own noise variance there (NaN where
+    /// not learned); None if the window was not covered (a gap, the start not taken) or the fit is
+    /// singular.
+    fn error_square(&self, noise_x: &[f64; 6]) -> Option<[f64; 6]> {
+        let (u, start, taken) = self.start?;
+        if self.weight < 0.5 * HINDSIGHT_HALF_WINDOW_S || self.powers[0] < 5.0 {
+            return None;
+        }
+        let p = &self.powers;
+        let normal = nalgebra::Matrix3::new(p[0], p[1], p[2], p[1], p[2], p[3], p[2], p[3], p[4]);
+        let inverse = normal.try_inverse()?;
+        let g = nalgebra::Vector3::new(1.0, u, u * u);
+        let gain = (g.transpose() * inverse * g)[(0, 0)];
+        if !gain.is_finite() {
+            return None;
+        }
+        Some(std::array::from_fn(|d| {
+            if !taken[d] {
+                return f64::NAN;
+            }
+            let a = inverse * nalgebra::Vector3::from(self.moments[d]);
+            let motion = a.dot(&g) - self.weighted[d] / self.weight;
+            let error = start[d] - motion;
+            error * error - gain * noise_x[d] * noise_x[d]
+        }))
+    }
+}
+
 /// A vessel's estimator: the kept window of filtered samples, the bias, and a run of refused samples
 /// that may turn out to be a real jump.
 #[derive(Debug, Clone)]
@@ -294,6 +390,12 @@ pub struct Estimator {
     /// velocity^2; over `bias_time_s`): what the filter's prediction actually errs by, its noise
     /// added ([`Estimator::start_var`]).
     innovation: [RunningMean; 3],
+    /// Open hindsight checks of the start, oldest first, and when the next opens.
+    checks: VecDeque<Check>,
+    next_check_s: Option<f64>,
+    /// The mean square of the start's error the closed checks found per DOF, their fit's own noise
+    /// off (m^2, rad^2; [`Estimator::start_var`]).
+    learned: RunningMean,
     /// Refused samples in a row that agree with each other, filtered from the first of them.
     candidate: Vec<Entry>,
     /// The values of the last sample received (taken or not), and how many received in a row
@@ -314,6 +416,9 @@ impl Estimator {
             entries: VecDeque::new(),
             bias: RunningMean::default(),
             innovation: Default::default(),
+            checks: VecDeque::new(),
+            next_check_s: None,
+            learned: RunningMean::default(),
             candidate: vec![],
             last_received: None,
             repeats: 0,
@@ -325,6 +430,8 @@ impl Estimator {
     pub fn restart(&mut self) {
         self.entries.clear();
         self.candidate.clear();
+        self.checks.clear();
+        self.next_check_s = None;
     }
 
     pub fn newest_time_s(&self) -> Option<f64> {
@@ -372,13 +479,68 @@ impl Estimator {
     /// [`Estimator::drift_in_bias_var`], is in the bias taken off); a DOF whose bias is not taken off
     /// (no restoring, or not yet averaged) keeps all of it. The raw method's is the sensor's noise and
     /// its drift. None before any sample.
+    ///
+    /// Where the start's error is learned (`Spec::learned`: heave), that figure is the prior of what
+    /// the sensor's own record shows in hindsight: once a sample is a minute old, the motion at it
+    /// (a quadratic fit to the samples about it) less the centred average about it (the sensor's
+    /// offset then: the motion's mean is nought) is what a start there should have been, and the
+    /// start actually taken there (the filtered displacement, the bias off) errs from it by what a
+    /// forecast's start errs by from the motion, the model's mean aside. The mean square of those
+    /// errors (the fit's own noise off) and the prior weigh by the time they span, the prior as
+    /// [`HINDSIGHT_PRIOR_BIAS_TIMES`] bias averages; the configured figure stays the least: hindsight
+    /// sees neither the model's mean nor the motion's slow wander, so what it shows is a part of the
+    /// error, and a sensor drifting less than its stated accuracy is not taken to.
     pub fn start_var(&self, t0_s: f64) -> Option<[f64; 6]> {
         let estimate = self.estimate_var(t0_s)?;
         let held = self.drift_in_bias_var();
+        let prior_s = HINDSIGHT_PRIOR_BIAS_TIMES * self.spec.bias_time_s;
+        let learned_s = self.learned.span_s.min(self.hindsight_memory_s());
         Some(std::array::from_fn(|d| {
             let s2 = self.spec.drift[d] * self.spec.drift[d];
-            estimate[d] + (s2 - held[d]).max(0.0)
+            let prior = estimate[d] + (s2 - held[d]).max(0.0);
+            if self.spec.learned[d] && self.bias_taken(d) && learned_s > 0.0 {
+                let learned = (prior_s * prior + learned_s * self.learned.value[d].max(0.0)) / (prior_s + learned_s);
+                learned.max(prior)
+            } else {
+                prior
+            }
         }))
+    }
+
+    fn hindsight_memory_s(&self) -> f64 {
+        HINDSIGHT_MEMORY_DRIFT_TIMES * self.spec.drift_time_s
+    }
+
+    /// Feeds the newest taken sample to the open hindsight checks, closes those a half window old
+    /// and opens the next on its cadence (Kalman method only: the raw method takes no bias off).
+    fn check_start(&mut self, dt_s: f64) {
+        if self.spec.method != Method::Kalman || !self.spec.learned.contains(&true) {
+            return;
+        }
+        let Some(e) = self.entries.back() else { return };
+        let (t, x) = (e.time_s, e.x);
+        let start: [f64; 6] = std::array::from_fn(|d| e.filtered[d].m[0]);
+        let next = *self.next_check_s.get_or_insert(t);
+        if t >= next {
+            self.checks.push_back(Check::new(t + HINDSIGHT_HALF_WINDOW_S));
+            self.next_check_s = Some(next + HINDSIGHT_EVERY_S * (((t - next) / HINDSIGHT_EVERY_S).floor() + 1.0));
+        }
+        let bias = self.bias();
+        let taken: [bool; 6] = std::array::from_fn(|d| self.spec.learned[d] && self.bias_taken(d));
+        for c in self.checks.iter_mut() {
+            c.add(t, dt_s, &x);
+            if c.start.is_none() && t >= c.centre_s {
+                c.start = Some((t - c.centre_s, std::array::from_fn(|d| start[d] - bias[d]), taken));
+            }
+        }
+        while self.checks.front().is_some_and(|c| t >= c.centre_s + HINDSIGHT_HALF_WINDOW_S) {
+            let Some(c) = self.checks.pop_front() else { break };
+            let Some(square) = c.error_square(&self.spec.noise_x) else {
+                continue;
+            };
+            let memory_s = self.hindsight_memory_s();
+            self.learned.add(HINDSIGHT_EVERY_S, &square, memory_s);
+        }
     }
 
     /// The estimate's own error variance at `t0_s` per DOF (m^2, rad^2; [`Estimator::start_var`]
@@ -570,6 +732,8 @@ impl Estimator {
         self.entries.clear();
         self.bias = RunningMean::default();
         self.innovation = Default::default();
+        self.checks.clear();
+        self.next_check_s = None;
         for e in std::mem::take(&mut self.candidate) {
             self.take(e);
         }
@@ -587,6 +751,7 @@ impl Estimator {
             None => 0.0,
         };
         self.bias.add(dt, &e.x, self.spec.bias_time_s);
+        let check_dt = dt;
         if self.entries.back().is_some() && dt > 0.0 {
             let n: [[f64; 2]; 6] =
                 std::array::from_fn(|d| [e.x[d] - e.predicted[d].m[0], e.v[d] - e.predicted[d].m[1]]);
@@ -597,6 +762,7 @@ impl Estimator {
         }
         let t = e.time_s;
         self.entries.push_back(e);
+        self.check_start(check_dt);
         while let Some(f) = self.entries.front() {
             if t - f.time_s > self.keep_s && self.entries.len() > 2 {
                 self.entries.pop_front();
@@ -743,6 +909,7 @@ mod tests {
             q,
             bounds: Bounds::from_system(&nalgebra::Matrix6::from_diagonal_element(1e6), 9.81, 2.0, 0.2),
             restored: [false, false, true, true, true, false],
+            learned: [false, false, true, false, false, false],
             bias_time_s: 100.0,
             drift: [0.0; 6],
             drift_time_s: 600.0,
@@ -894,6 +1061,8 @@ mod tests {
         let mut spec = spec(Method::Kalman);
         spec.drift = [0.0, 0.0, 0.02, 0.0, 0.0, 0.0];
         spec.drift_time_s = 600.0;
+        // the configured figure alone (the hindsight learning: below)
+        spec.learned = [false; 6];
         let mut e = Estimator::new(spec, 300.0);
         let (mut square, mut count, mut own, mut start) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..=4000 {
@@ -926,6 +1095,48 @@ mod tests {
         );
         // the rest of the drift is in the bias taken off
         assert!((e.drift_in_bias_var()[2] - 4e-4 * 6.0 / 7.0).abs() < 1e-12);
+    }
+
+    /// Heave's start error in hindsight: a drift of 5 cm over 15 minutes that the configured figure
+    /// (no drift) knows nothing of. Returns the mean square of the starts' actual error and the mean
+    /// start variance over the second quarter hour.
+    fn drifting_start(learned: bool) -> (f64, f64) {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut spec = spec(Method::Kalman);
+        spec.learned[2] = learned;
+        let mut e = Estimator::new(spec, 300.0);
+        let drift = |t: f64| 0.05 * (std::f64::consts::TAU * t / 900.0).sin();
+        let (mut square, mut var, mut count) = (0.0, 0.0, 0.0);
+        for k in 0..=18000 {
+            let t = k as f64 * 0.1;
+            let (mut x, v) = noisy_wave(t, &mut rng);
+            x[2] += drift(t);
+            e.push(t, x, v).unwrap();
+            if t >= 900.0 && k % 10 == 0 {
+                let r = e.resample(t, 0.1, 0, 1.0).unwrap();
+                // the motion itself: the wave less its constant bias
+                square += (r.x0[2] - (wave(t).0[2] - 0.2)).powi(2);
+                var += e.start_var(t).unwrap()[2];
+                count += 1.0;
+            }
+        }
+        (square / count, var / count)
+    }
+
+    #[test]
+    fn the_start_s_variance_learns_in_hindsight_what_the_sensor_s_drift_leaves() {
+        // ratio of the learned variance to the actual mean square: the prior (a fifth of the weight
+        // at 30 minutes) and the drift's change across the centred average keep it within this
+        const LEARNED_RATIO: (f64, f64) = (0.7, 1.4);
+        let (actual, learned) = drifting_start(true);
+        assert!(
+            learned > LEARNED_RATIO.0 * actual && learned < LEARNED_RATIO.1 * actual,
+            "learned {learned}, actual {actual}"
+        );
+        // the configured figure alone is the filter's error: far short of it
+        let (actual, configured) = drifting_start(false);
+        assert!(configured < 0.3 * actual, "configured {configured}, actual {actual}");
     }
 
     #[test]

@@ -594,6 +594,7 @@ pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeMode
             omega_min,
         ),
         restored: [false; 6],
+        learned: [false; 6],
         bias_time_s: e.bias_time_s,
         drift: [e.drift_m, e.drift_m, e.drift_m, e.drift_rad, e.drift_rad, e.drift_rad],
         drift_time_s: e.drift_time_s,
@@ -606,6 +607,7 @@ pub fn estimator_spec(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeMode
             && let Some(row) = model.active.iter().position(|&i| i == 6 * b + d)
         {
             spec.restored[d] = model.stiffness[(row, row)] > 0.0;
+            spec.learned[d] = spec.restored[d] && !MEASURED_MEAN_DOFS.contains(&d);
         }
     }
     spec
