@@ -332,7 +332,10 @@ impl Check {
     fn add(&mut self, t: f64, dt_s: f64, x: &[f64; 6]) {
         let u = t - self.centre_s;
         if u.abs() < HINDSIGHT_HALF_WINDOW_S {
-            let w = (std::f64::consts::FRAC_PI_2 * u / HINDSIGHT_HALF_WINDOW_S).cos().powi(2) * dt_s;
+            let w = (std::f64::consts::FRAC_PI_2 * u / HINDSIGHT_HALF_WINDOW_S)
+                .cos()
+                .powi(2)
+                * dt_s;
             self.weight += w;
             for (s, xd) in self.weighted.iter_mut().zip(x) {
                 *s += w * xd;
@@ -533,7 +536,11 @@ impl Estimator {
                 c.start = Some((t - c.centre_s, std::array::from_fn(|d| start[d] - bias[d]), taken));
             }
         }
-        while self.checks.front().is_some_and(|c| t >= c.centre_s + HINDSIGHT_HALF_WINDOW_S) {
+        while self
+            .checks
+            .front()
+            .is_some_and(|c| t >= c.centre_s + HINDSIGHT_HALF_WINDOW_S)
+        {
             let Some(c) = self.checks.pop_front() else { break };
             let Some(square) = c.error_square(&self.spec.noise_x) else {
                 continue;
@@ -751,7 +758,6 @@ impl Estimator {
             None => 0.0,
         };
         self.bias.add(dt, &e.x, self.spec.bias_time_s);
-        let check_dt = dt;
         if self.entries.back().is_some() && dt > 0.0 {
             let n: [[f64; 2]; 6] =
                 std::array::from_fn(|d| [e.x[d] - e.predicted[d].m[0], e.v[d] - e.predicted[d].m[1]]);
@@ -762,7 +768,7 @@ impl Estimator {
         }
         let t = e.time_s;
         self.entries.push_back(e);
-        self.check_start(check_dt);
+        self.check_start(dt);
         while let Some(f) = self.entries.front() {
             if t - f.time_s > self.keep_s && self.entries.len() > 2 {
                 self.entries.pop_front();
@@ -1126,8 +1132,8 @@ mod tests {
 
     #[test]
     fn the_start_s_variance_learns_in_hindsight_what_the_sensor_s_drift_leaves() {
-        // ratio of the learned variance to the actual mean square: the prior (a fifth of the weight
-        // at 30 minutes) and the drift's change across the centred average keep it within this
+        // ratio of the learned variance to the actual mean square: the hindsight checks lag a minute
+        // and more behind the drift, and the prior weighs a bias average's worth
         const LEARNED_RATIO: (f64, f64) = (0.7, 1.4);
         let (actual, learned) = drifting_start(true);
         assert!(
