@@ -313,8 +313,8 @@ struct Check {
     /// sum u^k (k = 0..4) and sum x u^k (k = 0..2) over the fit's samples, u = t - centre
     powers: [f64; 5],
     moments: [[f64; 3]; 6],
-    /// (u of the sample, its start less the bias, whether each DOF's bias was taken off there)
-    start: Option<(f64, [f64; 6], [bool; 6])>,
+    /// (u of the sample, its start less the bias)
+    start: Option<(f64, [f64; 6])>,
 }
 
 impl Check {
@@ -354,10 +354,10 @@ impl Check {
     }
 
     /// Per DOF, the square of the start's error less the fit's own noise variance there (NaN where
-    /// not learned); None if the window was not covered (a gap, the start not taken) or the fit is
-    /// singular.
-    fn error_square(&self, noise_x: &[f64; 6]) -> Option<[f64; 6]> {
-        let (u, start, taken) = self.start?;
+    /// not `learned`); None if the window was not covered (a gap, the start not taken) or the fit
+    /// is singular.
+    fn error_square(&self, noise_x: &[f64; 6], learned: &[bool; 6]) -> Option<[f64; 6]> {
+        let (u, start) = self.start?;
         if self.weight < 0.5 * HINDSIGHT_HALF_WINDOW_S || self.powers[0] < 5.0 {
             return None;
         }
@@ -370,7 +370,7 @@ impl Check {
             return None;
         }
         Some(std::array::from_fn(|d| {
-            if !taken[d] {
+            if !learned[d] {
                 return f64::NAN;
             }
             let a = inverse * nalgebra::Vector3::from(self.moments[d]);
@@ -516,8 +516,13 @@ impl Estimator {
 
     /// Feeds the newest taken sample to the open hindsight checks, closes those a half window old
     /// and opens the next on its cadence (Kalman method only: the raw method takes no bias off).
+    /// Checks open once the bias is taken off (it stays so until a restart of the samples, which
+    /// drops the open checks): a start with the bias on is not a forecast's.
     fn check_start(&mut self, dt_s: f64) {
-        if self.spec.method != Method::Kalman || !self.spec.learned.contains(&true) {
+        let Some(d) = self.spec.learned.iter().position(|&l| l) else {
+            return;
+        };
+        if !self.bias_taken(d) {
             return;
         }
         let Some(e) = self.entries.back() else { return };
@@ -529,11 +534,10 @@ impl Estimator {
             self.next_check_s = Some(next + HINDSIGHT_EVERY_S * (((t - next) / HINDSIGHT_EVERY_S).floor() + 1.0));
         }
         let bias = self.bias();
-        let taken: [bool; 6] = std::array::from_fn(|d| self.spec.learned[d] && self.bias_taken(d));
         for c in self.checks.iter_mut() {
             c.add(t, dt_s, &x);
             if c.start.is_none() && t >= c.centre_s {
-                c.start = Some((t - c.centre_s, std::array::from_fn(|d| start[d] - bias[d]), taken));
+                c.start = Some((t - c.centre_s, std::array::from_fn(|d| start[d] - bias[d])));
             }
         }
         while self
@@ -542,7 +546,7 @@ impl Estimator {
             .is_some_and(|c| t >= c.centre_s + HINDSIGHT_HALF_WINDOW_S)
         {
             let Some(c) = self.checks.pop_front() else { break };
-            let Some(square) = c.error_square(&self.spec.noise_x) else {
+            let Some(square) = c.error_square(&self.spec.noise_x, &self.spec.learned) else {
                 continue;
             };
             let memory_s = self.hindsight_memory_s();
@@ -1143,6 +1147,23 @@ mod tests {
         // the configured figure alone is the filter's error: far short of it
         let (actual, configured) = drifting_start(false);
         assert!(configured < 0.3 * actual, "configured {configured}, actual {actual}");
+    }
+
+    #[test]
+    fn hindsight_checks_count_only_starts_taken_with_the_bias_off() {
+        // a bias average of 1000 s is taken off from 200 s: a check of a start before then would
+        // count a start with the bias on (or none) and weigh the learned mean toward nought
+        let mut spec = spec(Method::Kalman);
+        spec.bias_time_s = 1000.0;
+        let mut e = Estimator::new(spec, 300.0);
+        for k in 0..=4000 {
+            let t = k as f64 * 0.1;
+            let (x, v) = wave(t);
+            e.push(t, x, v).unwrap();
+        }
+        // checks open from 200 s, every 10 s; each closes 2 x 60 s later: those opened at 200-280 s
+        let closed = ((400.0 - 200.0 - 2.0 * HINDSIGHT_HALF_WINDOW_S) / HINDSIGHT_EVERY_S).floor() + 1.0;
+        assert_eq!(e.learned.span_s, closed * HINDSIGHT_EVERY_S);
     }
 
     #[test]
