@@ -61,6 +61,11 @@ pub const HINDSIGHT_HALF_WINDOW_S: f64 = 60.0;
 pub const HINDSIGHT_FIT_HALF_S: f64 = 1.0;
 /// A hindsight check of the start opens this often, s.
 pub const HINDSIGHT_EVERY_S: f64 = 10.0;
+/// A check counts if its fit holds this many samples (a parabola through three is no fit: at least
+/// two more to average the noise; a sensor of 2 Hz or less never has them) ...
+pub const HINDSIGHT_MIN_FIT_SAMPLES: f64 = 5.0;
+/// ... and its samples weigh at least this share of a whole window's (gaps leave the average lopsided).
+pub const HINDSIGHT_MIN_COVER: f64 = 0.5;
 /// The configured figure ([`Estimator::start_var`]'s prior) weighs as much as this many
 /// `bias_time_s` of hindsight checks: within the half hour the sensor's own record outweighs it.
 pub const HINDSIGHT_PRIOR_BIAS_TIMES: f64 = 1.0;
@@ -358,7 +363,8 @@ impl Check {
     /// is singular.
     fn error_square(&self, noise_x: &[f64; 6], learned: &[bool; 6]) -> Option<[f64; 6]> {
         let (u, start) = self.start?;
-        if self.weight < 0.5 * HINDSIGHT_HALF_WINDOW_S || self.powers[0] < 5.0 {
+        // a whole window's Hann weights sum to its half width
+        if self.weight < HINDSIGHT_MIN_COVER * HINDSIGHT_HALF_WINDOW_S || self.powers[0] < HINDSIGHT_MIN_FIT_SAMPLES {
             return None;
         }
         let p = &self.powers;
