@@ -19,8 +19,9 @@
 //! - `/motion` (`shipcast.Motion`): `{"vessel", "time_s", "x": [6], "v": [6]}` (measured; body-frame
 //!   surge..yaw, m and rad)
 //! - `/waves` (`shipcast.Waves`): `{"time_s", "ref_east_m", "ref_north_m", "radius_m", "depth_m",
-//!   "g_m_s2", "window_s", "components": [[omega_rad_s, direction_rad, re_m, im_m], ...]}` (earth frame, as on the
-//!   wire)
+//!   "g_m_s2", "window_s", "inner_m", "coverage_ranges_m": [...], "components": [[omega_rad_s,
+//!   direction_rad, re_m, im_m], ...]}` (earth frame, as on the wire; a radar's blind zone and
+//!   coverage, absent from logs before version 5 and for a field without them)
 //! - `/truth` (`shipcast.Motion`): like `/motion`, the simulator's true motion (absent from real logs)
 //! - `/forecast` (`shipcast.Forecast`): `{"issue_time_s", "dt_s", "steps", "flags", "wave_time_s",
 //!   "motion_time_s", "compute_ms", "horizon_s": [..], "trusted_from_s": [..], "values": [...],
@@ -42,7 +43,7 @@
 //! read as they are.
 
 use crate::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
-use crate::waves::field::{FlatHeader, WaveField};
+use crate::waves::field::{FlatHeader, WaveField, coverage_from_sectors};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -53,7 +54,7 @@ use std::path::Path;
 /// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
 /// `/radar`; 3: `/navigation`, `/elevation`; 4: a forecast's `sigma` and `trusted_from_s`, a wave
 /// field's `window_s`.
-pub const LOG_SCHEMA_VERSION: u32 = 4;
+pub const LOG_SCHEMA_VERSION: u32 = 5;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -139,7 +140,8 @@ pub struct WavesRecord {
     pub ref_east_m: f64,
     /// Reference point, earth frame, m north.
     pub ref_north_m: f64,
-    /// Radius of the observed disc, m (0: a point observation).
+    /// Radius of the observed disc, m (0: no region known; negative: a wave probe at the reference
+    /// point; with `coverage_ranges_m`, the farthest of them).
     pub radius_m: f64,
     /// Water depth, m (0: deep water).
     pub depth_m: f64,
@@ -148,6 +150,15 @@ pub struct WavesRecord {
     /// A wave probe's fitted record, s (0 or absent: not said, or not a probe).
     #[serde(default)]
     pub window_s: f64,
+    /// A radar's blind zone: nothing within this of the reference point was observed, m (0 or
+    /// absent: none; before log version 5 not recorded).
+    #[serde(default)]
+    pub inner_m: f64,
+    /// A radar's coverage: the farthest point observed in each of as many equal sectors of direction
+    /// from the reference point (sector j spans j..j+1 times 360 / n deg, counterclockwise from
+    /// east), m (absent: the disc of `radius_m`; before log version 5 not recorded).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub coverage_ranges_m: Vec<f64>,
     /// Components `[omega_rad_s, direction_rad (travel-to, counterclockwise from east), re_m, im_m]`.
     pub components: Vec<[f64; 4]>,
 }
@@ -205,6 +216,8 @@ impl WavesRecord {
             depth_m: h.depth_m,
             g_m_s2: h.g_m_s2,
             window_s: h.window_s,
+            inner_m: h.inner_m,
+            coverage_ranges_m: h.ranges_m.map_or(vec![], |r| r.to_vec()),
             components: f.flat_rows().collect(),
         }
     }
@@ -217,6 +230,8 @@ impl WavesRecord {
             depth_m: self.depth_m,
             g_m_s2: self.g_m_s2,
             window_s: self.window_s,
+            inner_m: self.inner_m,
+            ranges_m: coverage_from_sectors(&self.coverage_ranges_m).map_err(|e| e.to_string())?,
         };
         WaveField::from_flat(h, self.components.iter().copied()).map_err(|e| e.to_string())
     }

@@ -143,24 +143,42 @@ fn link_service(node: &Node<ipc::Service>, names: &Names) -> Result<FixedService
         .map_err(err)
 }
 
+/// A wave field as it goes on the wire: the header and the payload (the components' rows, then the
+/// coverage's ranges if it has one).
+pub fn encode_waves(f: &WaveField) -> (WaveHeader, Vec<f64>) {
+    let flat = f.flat_header();
+    let mut values: Vec<f64> = f.flat_rows().flatten().collect();
+    let sectors = flat.ranges_m.map_or(vec![], |r| r.to_vec());
+    values.extend_from_slice(&sectors);
+    (WaveHeader::of(f.components.len(), sectors.len(), &flat), values)
+}
+
 /// A wave field decoded from the wire.
 pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<WaveField, String> {
-    if h.schema_version != SCHEMA_VERSION {
+    if h.schema_version != WAVES_SCHEMA_VERSION {
         return Err(format!(
-            "wave field of schema version {} (this shipcast reads {SCHEMA_VERSION})",
+            "wave field of schema version {} (this shipcast reads {WAVES_SCHEMA_VERSION})",
             h.schema_version
         ));
     }
     crate::ipc::wire::check_wave_components(h.n_components as usize)?;
-    if payload.len() != 4 * h.n_components as usize {
+    let (n, sectors) = (h.n_components as usize, h.n_sectors as usize);
+    if sectors > crate::waves::field::MAX_GIVEN_SECTORS {
         return Err(format!(
-            "wave field: {} values for {} components (4 each)",
-            payload.len(),
-            h.n_components
+            "wave field: coverage in {sectors} sectors, more than {}",
+            crate::waves::field::MAX_GIVEN_SECTORS
         ));
     }
-    let rows = payload.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]);
-    WaveField::from_flat(h.flat(), rows).map_err(|e| format!("wave field: {e}"))
+    if payload.len() != 4 * n + sectors {
+        return Err(format!(
+            "wave field: {} values for {n} components (4 each) and {sectors} coverage sectors",
+            payload.len(),
+        ));
+    }
+    let ranges =
+        crate::waves::field::coverage_from_sectors(&payload[4 * n..]).map_err(|e| format!("wave field: {e}"))?;
+    let rows = payload[..4 * n].chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]);
+    WaveField::from_flat(h.flat(ranges), rows).map_err(|e| format!("wave field: {e}"))
 }
 
 /// A radar scan decoded from the wire: the grid (its axes' coordinates from the frame's origin; NaN
@@ -685,8 +703,7 @@ impl SensorPublisher {
     }
 
     pub fn waves(&self, f: &WaveField) -> Result<()> {
-        let values: Vec<f64> = f.flat_rows().flatten().collect();
-        let h = WaveHeader::of(f.components.len(), &f.flat_header());
+        let (h, values) = encode_waves(f);
         let s = self.waves.loan_slice_uninit(values.len()).map_err(err)?;
         let mut s = s.write_from_slice(&values);
         *s.user_header_mut() = h;
@@ -847,6 +864,76 @@ mod tests {
         assert!((rec.frame.orientation_rad - 0.3).abs() < 1e-12);
         assert_eq!(rec.grid.y_m, s.grid.y_m);
         assert!((rec.grid.time_s - s.grid.time_s).abs() < 1e-6);
+    }
+
+    fn covered_field() -> WaveField {
+        WaveField {
+            components: vec![crate::waves::field::FieldComponent {
+                omega_rad_s: 0.7,
+                direction_rad: 1.0,
+                amplitude_m: num_complex::Complex64::new(0.4, -0.3),
+            }],
+            reference_m: [50.0, 20.0],
+            time_s: 1.75e9,
+            g_m_s2: 9.81,
+            depth_m: None,
+            region: crate::waves::field::Region::Coverage {
+                centre_m: [50.0, 20.0],
+                inner_m: 200.0,
+                ranges_m: std::array::from_fn(|j| if j < 10 { 0.0 } else { 990.0 }),
+            },
+        }
+    }
+
+    #[test]
+    fn a_radar_field_goes_over_the_wire_and_into_a_log_and_back_with_what_it_saw() {
+        let f = covered_field();
+        let (h, v) = encode_waves(&f);
+        assert_eq!((h.n_components, h.n_sectors, v.len()), (1, 72, 4 + 72));
+        assert_eq!(decode_waves(&h, &v).unwrap(), f);
+        assert_eq!(crate::record::WavesRecord::of(&f).field().unwrap(), f);
+        // a field without a coverage sends none
+        let disc = WaveField {
+            region: crate::waves::field::Region::Disc {
+                centre_m: [50.0, 20.0],
+                radius_m: 800.0,
+            },
+            ..f.clone()
+        };
+        let (h, v) = encode_waves(&disc);
+        assert_eq!((h.n_sectors, v.len()), (0, 4));
+        assert_eq!(decode_waves(&h, &v).unwrap(), disc);
+        // a processor's coverage in 360 sectors of 1 deg
+        let (h, mut v) = encode_waves(&disc);
+        v.extend((0..360).map(|i| if i < 50 { 0.0 } else { 990.0 }));
+        let back = decode_waves(
+            &WaveHeader {
+                n_sectors: 360,
+                inner_m: 200.0,
+                ..h
+            },
+            &v,
+        )
+        .unwrap();
+        assert_eq!(back, f);
+    }
+
+    #[test]
+    fn a_wave_field_whose_header_does_not_fit_its_payload_is_refused() {
+        let (h, v) = encode_waves(&covered_field());
+        let bad = [
+            (WaveHeader { n_sectors: 71, ..h }, "76 values"),
+            (WaveHeader { n_sectors: 5000, ..h }, "5000 sectors"),
+            (WaveHeader { schema_version: 1, ..h }, "schema version 1"),
+            (WaveHeader { inner_m: f64::NAN, ..h }, "blind zone"),
+        ];
+        for (b, says) in bad {
+            let err = decode_waves(&b, &v).unwrap_err();
+            assert!(err.contains(says), "{err}");
+        }
+        let mut v = v;
+        v[4 + 3] = -5.0;
+        assert!(decode_waves(&h, &v).unwrap_err().contains("coverage sector 3"));
     }
 
     #[test]

@@ -15,8 +15,10 @@
 //! - `elevation`: a slice of f32 with an [`ElevationHeader`]: one radar scan, `n_x * n_y` elevations (m)
 //!   row by row (`values[iy * n_x + ix]`), NaN where the cell is not valid (blind zone, shadow, a
 //!   masked sector, beyond the range). The daemon inverts a sequence of scans into a field itself.
-//! - `waves`: a slice of f64 with a [`WaveHeader`]: 4 values per component: omega (rad/s), direction
-//!   (rad, earth), Re and Im of the complex amplitude (m) at the header's reference point and time.
+//! - `waves`: a slice of f64 with a [`WaveHeader`] (schema version [`WAVES_SCHEMA_VERSION`]): 4 values
+//!   per component: omega (rad/s), direction (rad, earth), Re and Im of the complex amplitude (m) at
+//!   the header's reference point and time; then, if the header says so, the radar's coverage: the
+//!   farthest point observed in each of `n_sectors` sectors of direction (m).
 //! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
 //!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad); then as many
 //!   standard deviations, same order (the forecast's band: `rom::spread`). Schema version
@@ -27,8 +29,10 @@
 use crate::waves::field::FlatHeader;
 use iceoryx2::prelude::*;
 
-/// Schema version of the motion, navigation, elevation and waves payloads.
+/// Schema version of the motion, navigation and elevation payloads.
 pub const SCHEMA_VERSION: u32 = 1;
+/// Schema version of the waves payload (2: the radar's blind zone and coverage).
+pub const WAVES_SCHEMA_VERSION: u32 = 2;
 /// Schema version of the forecast payload (2: the standard deviations after the displacements, the
 /// start of each vessel's trusted span).
 pub const FORECAST_SCHEMA_VERSION: u32 = 2;
@@ -205,9 +209,9 @@ pub struct ElevationHeader {
 /// The largest radar grid the daemon takes: cells along each axis (a 1024 x 1024 scan is 4 MB).
 pub const MAX_GRID_CELLS: u32 = 1024;
 
-/// Header of a wave-field sample. 64 bytes.
+/// Header of a wave-field sample. 80 bytes; `schema_version` = [`WAVES_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("shipcast_WaveHeader_v1")]
+#[type_name("shipcast_WaveHeader_v2")]
 #[repr(C)]
 pub struct WaveHeader {
     pub schema_version: u32,
@@ -226,13 +230,23 @@ pub struct WaveHeader {
     pub g_m_s2: f64,
     /// A wave probe's fitted record, s (0: not said, or not a probe).
     pub window_s: f64,
+    /// A radar's blind zone: nothing within this of the reference point was observed, m (0: none).
+    pub inner_m: f64,
+    /// A radar's coverage: the payload's last `n_sectors` values (after the components) are the
+    /// farthest point observed in each of as many equal sectors of direction from the reference
+    /// point, m (sector j spans j..j+1 times 360 / n_sectors deg, counterclockwise from east: what
+    /// shadowing and a masked sector left). 0: the disc of `radius_m` (beyond `inner_m`). At most
+    /// 3600.
+    pub n_sectors: u32,
+    pub reserved: u32,
 }
 
 impl WaveHeader {
-    /// The header of a field of `n_components` components (this schema version).
-    pub fn of(n_components: usize, h: &FlatHeader) -> WaveHeader {
+    /// The header of a field of `n_components` components (this schema version), its coverage in
+    /// `n_sectors` sectors after them.
+    pub fn of(n_components: usize, n_sectors: usize, h: &FlatHeader) -> WaveHeader {
         WaveHeader {
-            schema_version: SCHEMA_VERSION,
+            schema_version: WAVES_SCHEMA_VERSION,
             n_components: n_components as u32,
             time_s: h.time_s,
             ref_east_m: h.reference_m[0],
@@ -241,11 +255,14 @@ impl WaveHeader {
             depth_m: h.depth_m,
             g_m_s2: h.g_m_s2,
             window_s: h.window_s,
+            inner_m: h.inner_m,
+            n_sectors: n_sectors as u32,
+            reserved: 0,
         }
     }
 
-    /// The field's header numbers.
-    pub fn flat(&self) -> FlatHeader {
+    /// The field's header numbers, with its coverage in [`crate::waves::field::COVERAGE_SECTORS`].
+    pub fn flat(&self, ranges_m: Option<[f64; crate::waves::field::COVERAGE_SECTORS]>) -> FlatHeader {
         FlatHeader {
             time_s: self.time_s,
             reference_m: [self.ref_east_m, self.ref_north_m],
@@ -253,6 +270,8 @@ impl WaveHeader {
             depth_m: self.depth_m,
             g_m_s2: self.g_m_s2,
             window_s: self.window_s,
+            inner_m: self.inner_m,
+            ranges_m,
         }
     }
 }
@@ -527,7 +546,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
         assert_eq!(std::mem::size_of::<ElevationHeader>(), 64);
-        assert_eq!(std::mem::size_of::<WaveHeader>(), 64);
+        assert_eq!(std::mem::size_of::<WaveHeader>(), 80);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 128);
         assert_eq!(std::mem::size_of::<Status>(), 384);
         assert_eq!(std::mem::size_of::<LinkStatus>(), 64);

@@ -13,10 +13,13 @@
 //! rings on in the motion for about the response's group delay tau = -d arg H / d w (at a resonance
 //! 1 / (zeta w_n), the decay time of its amplitude), so its error variance falls from its whole to
 //! nothing over s..s + tau, linearly (the area of exp(-2 (t - s) / tau)). The end of its span is not
-//! moved: the error of the waves after it grows from there. The standard deviation of each series
+//! moved: the error of the waves after it grows from there. A component unknown from the start (the
+//! waves inside a radar's blind zone, or from where nothing was observed) errs by nothing at lead 0,
+//! where the measured state holds the response to every wave before it: its error builds up as the
+//! response to a force switched on then, linearly over [`ONSET_DELAY_TIMES`] tau. The standard deviation of each series
 //! at lead t is then
 //!
-//!   sigma^2(t) = k^2(t) (2 sum_c u_c(t) v_c + e^2 sum_c v_c),  u_c(t) = 1 unknown, 0 known, the ramp between
+//!   sigma^2(t) = k^2(t) (2 sum_c u_c(t) v_c + e^2 sum_c v_c),  u_c(t) = 1 unknown, 0 known, the ramps between
 //!
 //! with e the model error as a fraction of the motion's own standard deviation (config
 //! `forecast.model_error` until [`ModelError`] has learnt it from the daemon's past forecasts), and
@@ -40,6 +43,14 @@ use std::f64::consts::TAU;
 /// response variance: the forecast's guess and the sea's unobserved part are independent.
 pub const UNKNOWN_ERROR_FACTOR: f64 = 2.0;
 
+/// A component unknown from a forecast's start (a radar's blind zone, waves from where nothing was
+/// observed) errs by nothing at lead 0, where the measured state holds the response to every wave
+/// before it: the error its unknown force makes is the response to a force switched on then, which
+/// builds up as (1 - exp(-t / tau))^2 of its whole (tau the response's group delay: at a resonance the
+/// decay time of its amplitude, 47 s for a roll at 5 % of critical and 0.43 rad/s). Taken as a linear
+/// ramp over this many tau, which leaves out the same area (1.5 tau).
+pub const ONSET_DELAY_TIMES: f64 = 3.0;
+
 /// The longest group delay of a response counted, s (a resonance with 1 % of critical damping at
 /// 1.6 rad/s; beyond, the delay is a phase jump where the response vanishes, not a memory).
 pub const MAX_GROUP_DELAY_S: f64 = 60.0;
@@ -54,15 +65,18 @@ const TABLE_OMEGAS: usize = 240;
 /// Headings of the response table (every 10 deg).
 const TABLE_HEADINGS: usize = 36;
 
-/// |H|^2 of every mode on a grid of frequency and relative heading, interpolated bilinearly (heading
-/// wrapping around the circle); zero outside the frequency range, as the forecast leaves out the waves
-/// the database does not cover.
+/// |H| of every mode on a grid of frequency and relative heading, interpolated bilinearly (heading
+/// wrapping around the circle) and squared: a response vanishes linearly through a heading where the
+/// hull's symmetry cancels it (pitch and heave in beam seas, roll in head seas), which interpolating
+/// |H|^2 would overstate between the grid's headings (by the ratio of the step to the offset: 5 times
+/// at 2 deg off beam on a 10 deg grid). Zero outside the frequency range, as the forecast leaves out
+/// the waves the database does not cover.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseTable {
     omega_rad_s: Vec<f64>,
     n_modes: usize,
-    /// gain2[(iw * TABLE_HEADINGS + ib) * n_modes + i], m^2/m^2 or rad^2/m^2.
-    gain2: Vec<f64>,
+    /// |H|: gain[(iw * TABLE_HEADINGS + ib) * n_modes + i], m/m or rad/m.
+    gain: Vec<f64>,
     /// The response's group delay, same layout, s (0..[`MAX_GROUP_DELAY_S`]).
     delay_s: Vec<f64>,
 }
@@ -91,7 +105,7 @@ impl ResponseTable {
                 }
             }
         }
-        let gain2 = rao.iter().map(|r| r.norm_sqr()).collect();
+        let gain = rao.iter().map(|r| r.norm()).collect();
         // -d arg H / d w by the phase change between neighbouring frequencies (one-sided at the ends)
         let at = |iw: usize, ib: usize, i: usize| rao[(iw * TABLE_HEADINGS + ib) * n_modes + i];
         let dw = omega_rad_s[1] - omega_rad_s[0];
@@ -113,7 +127,7 @@ impl ResponseTable {
         Ok(ResponseTable {
             omega_rad_s,
             n_modes,
-            gain2,
+            gain,
             delay_s,
         })
     }
@@ -143,13 +157,16 @@ impl ResponseTable {
                     continue;
                 }
                 let at = (wi * TABLE_HEADINGS + bi) * n;
-                for (o, g) in gain2.iter_mut().zip(&self.gain2[at..at + n]) {
+                for (o, g) in gain2.iter_mut().zip(&self.gain[at..at + n]) {
                     *o += c * g;
                 }
                 for (o, d) in delay_s.iter_mut().zip(&self.delay_s[at..at + n]) {
                     *o += c * d;
                 }
             }
+        }
+        for g in gain2.iter_mut() {
+            *g *= *g;
         }
     }
 }
@@ -233,31 +250,43 @@ pub fn spread(
                 if vr.is_nan() || vr <= 0.0 {
                     continue;
                 }
-                // known over steps ks..ke (exclusive), unknown before and after; a start after the
-                // forecast's own rings on over kr steps (ramping down to known)
+                // known over steps ks..ke (exclusive), unknown before and after; never known: unknown
+                // from the start (ks = ke = n)
                 let ks = step(s);
                 let ke = if e.is_finite() {
                     step(e + 1e-9 * dt_s).max(ks)
                 } else {
                     n
                 };
-                let ke = if e >= s { ke } else { ks };
-                let kr = if s > 0.0 {
+                let (ks, ke) = if e > s && ke > ks { (ks, ke) } else { (n, n) };
+                total[i] += vr;
+                let u = UNKNOWN_ERROR_FACTOR * vr;
+                // unknown from the start: the error builds up over ko steps, then whole until ks
+                let ko = ((ONSET_DELAY_TIMES * delay[i] / dt_s).round() as usize).min(n);
+                let built = if ko > 0 { u * (ks.min(ko) as f64 / ko as f64) } else { u };
+                if ko > 0 {
+                    let rate = u / ko as f64;
+                    slope[i][0] += rate;
+                    slope[i][ks.min(ko)] -= rate;
+                }
+                if ko < ks {
+                    diff[i][ko] += u;
+                    diff[i][ks] -= u;
+                }
+                // unknown again after the span
+                diff[i][ke] += u;
+                diff[i][n] -= u;
+                // a start after the forecast's own rings on over kr steps, from what it had built up
+                // to nothing: built (1 - (k - ks) / kr) over ks..ks + kr
+                let kr = if ks > 0 && ks < n {
                     ((delay[i] / dt_s).round() as usize).min(ke - ks)
                 } else {
                     0
                 };
-                total[i] += vr;
-                let u = UNKNOWN_ERROR_FACTOR * vr;
-                diff[i][0] += u;
-                diff[i][ks] -= u;
-                diff[i][ke] += u;
-                diff[i][n] -= u;
-                if kr > 0 {
-                    // u (1 - (k - ks) / kr) over ks..ks + kr: u (1 + ks / kr) - (u / kr) k
-                    let rate = u / kr as f64;
-                    diff[i][ks] += u + rate * ks as f64;
-                    diff[i][ks + kr] -= u + rate * ks as f64;
+                if kr > 0 && built > 0.0 {
+                    let rate = built / kr as f64;
+                    diff[i][ks] += built + rate * ks as f64;
+                    diff[i][ks + kr] -= built + rate * ks as f64;
                     slope[i][ks] -= rate;
                     slope[i][ks + kr] += rate;
                 }
@@ -825,7 +854,7 @@ mod tests {
         ResponseTable {
             omega_rad_s: vec![0.2, 2.0],
             n_modes,
-            gain2: vec![gain * gain; 2 * TABLE_HEADINGS * n_modes],
+            gain: vec![gain; 2 * TABLE_HEADINGS * n_modes],
             delay_s: vec![5.0; 2 * TABLE_HEADINGS * n_modes],
         }
     }
@@ -920,7 +949,7 @@ mod tests {
         let table = ResponseTable {
             omega_rad_s: vec![0.1, 3.0],
             n_modes: 6,
-            gain2: vec![0.0; 2 * TABLE_HEADINGS * 6],
+            gain: vec![0.0; 2 * TABLE_HEADINGS * 6],
             delay_s: vec![0.0; 2 * TABLE_HEADINGS * 6],
         };
         let mut curve = ModelErrorCurve::prior(0.0, 1);
@@ -1078,7 +1107,8 @@ mod tests {
         // up to 30 s, then growing in proportion to the lead
         let expect = |unknown: f64| (unknown + 0.01_f64).sqrt();
         let expect_at = |unknown: f64, lead: f64| (unknown + (0.1 * lead / PRIOR_LEAD_S).powi(2)).sqrt();
-        assert!((heave[10] - expect(1.0)).abs() < 1e-12);
+        // the second one, unknown from the start, builds its error up over 3 x its 5 s memory
+        assert!((heave[10] - expect(1.0 * 10.0 / 15.0)).abs() < 1e-12, "{}", heave[10]);
         assert!((heave[30] - expect(0.0)).abs() < 1e-12);
         assert!((heave[50] - expect_at(1.0, 50.0)).abs() < 1e-12);
         assert!((heave[80] - expect_at(2.0, 80.0)).abs() < 1e-12);
@@ -1089,6 +1119,67 @@ mod tests {
         assert!((heave[25] - expect(0.0)).abs() < 1e-12);
         assert_eq!((s.from_s[0], s.to_s[0]), (24.0, 40.0));
         assert!((s.motion_sigma[2] - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_response_that_vanishes_through_a_heading_is_not_overstated_beside_it() {
+        // pitch's |H| 1 at 80 deg, 0 at 90 deg (beam seas): 2 deg off beam it is 0.2, its square
+        // 0.04 (fails before |H| was interpolated: its square interpolated gave 0.2)
+        let mut table = flat_table(6, 0.0);
+        for iw in 0..2 {
+            table.gain[(iw * TABLE_HEADINGS + 8) * 6 + 4] = 1.0;
+        }
+        let (mut g2, mut delay) = (vec![0.0; 6], vec![0.0; 6]);
+        table.gain2_into(1.0, 88f64.to_radians(), &mut g2, &mut delay);
+        assert!((g2[4] - 0.04).abs() < 1e-12, "{g2:?}");
+        table.gain2_into(1.0, 80f64.to_radians(), &mut g2, &mut delay);
+        assert!((g2[4] - 1.0).abs() < 1e-12, "{g2:?}");
+    }
+
+    #[test]
+    fn a_component_unknown_from_the_start_errs_by_nothing_at_lead_0_and_builds_up_over_its_memory() {
+        // heave gain 1, group delay 5 s: a force switched on at the start makes its whole error over
+        // ONSET_DELAY_TIMES x 5 = 15 s (fails before the onset: the whole error from the first step)
+        let table = flat_table(6, 1.0);
+        let wave = [WaveComponent {
+            omega_rad_s: 0.6,
+            heading_rad: std::f64::consts::PI,
+            amplitude_m: Complex64::new(1.0, 0.0),
+        }];
+        let opts = SpreadOptions {
+            model_error: ModelErrorCurve::prior(0.0, 6),
+            trusted_nrmse: 0.6,
+            start_var: vec![],
+            start_offset: vec![],
+        };
+        let heave = |known: [f64; 2]| {
+            let s = spread(&table, &wave, &[vec![known]], 1, 0.0, 9.81, None, 60, 1.0, &opts);
+            s.sigma[2 * 61..3 * 61].to_vec()
+        };
+        // whole unknown error 2 x 0.5 = 1 m^2; past lead 5 s (the start's share gone) the band is it
+        let never = heave([0.0, 0.0]);
+        for (k, want) in [(6, 6.0 / 15.0), (12, 12.0 / 15.0), (15, 1.0), (40, 1.0)] {
+            assert!(
+                (never[k] * never[k] - want).abs() < 1e-12,
+                "never known, lead {k}: {}",
+                never[k]
+            );
+        }
+        // known from 9 s: built up to 9 / 15 by then, ringing down over 5 s, unknown again after 30 s
+        let blind = heave([9.0, 30.0]);
+        for (k, want) in [
+            (6, 6.0 / 15.0),
+            (8, 8.0 / 15.0),
+            (11, 0.6 * 3.0 / 5.0),
+            (20, 0.0),
+            (40, 1.0),
+        ] {
+            assert!(
+                (blind[k] * blind[k] - want).abs() < 1e-12,
+                "known 9-30 s, lead {k}: {}",
+                blind[k]
+            );
+        }
     }
 
     #[test]

@@ -101,7 +101,10 @@ pub struct WaveField {
 /// log (`record::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
 /// Radius 0 = no region known (read back as [`Region::Everywhere`]); a negative radius = a wave probe
 /// at the reference point ([`Region::Point`]; a probe's field is referred to its point); depth 0 =
-/// infinite. `window_s`: a probe's fitted record, s (0: not said, or not a probe).
+/// infinite. `window_s`: a probe's fitted record, s (0: not said, or not a probe). A radar's view
+/// ([`Region::Coverage`], seen from the reference point): `inner_m` its blind zone (0: none) and
+/// `ranges_m` the farthest point seen per sector (None: the disc of `radius_m`, less the blind zone),
+/// `radius_m` then the farthest of them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlatHeader {
     pub time_s: f64,
@@ -110,6 +113,44 @@ pub struct FlatHeader {
     pub depth_m: f64,
     pub g_m_s2: f64,
     pub window_s: f64,
+    pub inner_m: f64,
+    pub ranges_m: Option<[f64; COVERAGE_SECTORS]>,
+}
+
+/// The most sectors a coverage may be given in on the wire or in a log (a tenth of a degree each).
+pub const MAX_GIVEN_SECTORS: usize = 3600;
+
+/// A coverage given as the farthest point seen in each of `given.len()` equal sectors of direction
+/// (sector i spans i..i+1 times 360 / n deg, counterclockwise from east; m), in
+/// [`COVERAGE_SECTORS`] sectors: each the nearest of the given sectors it overlaps (what was seen
+/// all across it). None for none given; an error names the first range that is not a finite number
+/// >= 0, or too many sectors.
+pub fn coverage_from_sectors(given: &[f64]) -> Result<Option<[f64; COVERAGE_SECTORS]>> {
+    let n = given.len();
+    if n == 0 {
+        return Ok(None);
+    }
+    if n > MAX_GIVEN_SECTORS {
+        return Err(Error::Invalid(format!(
+            "coverage in {n} sectors: at most {MAX_GIVEN_SECTORS}"
+        )));
+    }
+    if let Some(i) = given.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
+        return Err(Error::Invalid(format!(
+            "coverage sector {i}: range {} m must be a finite number >= 0",
+            given[i]
+        )));
+    }
+    Ok(Some(std::array::from_fn(|j| {
+        // the given sectors overlapping [j, j + 1) of ours, in units of theirs (exact where n is a
+        // multiple of COVERAGE_SECTORS or a divisor)
+        let scale = n as f64 / COVERAGE_SECTORS as f64;
+        let lo = ((j as f64 * scale) + 1e-9).floor() as usize;
+        let hi = (((j + 1) as f64 * scale) - 1e-9).ceil() as usize;
+        given[lo.min(n - 1)..hi.clamp(lo.min(n - 1) + 1, n)]
+            .iter()
+            .fold(f64::INFINITY, |m, r| m.min(*r))
+    })))
 }
 
 /// Converts a compass heading (clockwise from north, degrees) to a direction counterclockwise from
@@ -153,7 +194,6 @@ impl WaveField {
             reference_m: self.reference_m,
             radius_m: match self.region {
                 Region::Disc { radius_m, .. } => radius_m,
-                // on the wire and in logs, the disc of its farthest reach
                 Region::Coverage { ranges_m, .. } => ranges_m.iter().fold(0.0, |m, r| m.max(*r)),
                 Region::Point { .. } => -1.0,
                 Region::Everywhere => 0.0,
@@ -163,6 +203,14 @@ impl WaveField {
             window_s: match self.region {
                 Region::Point { window_s, .. } => window_s,
                 _ => 0.0,
+            },
+            inner_m: match self.region {
+                Region::Coverage { inner_m, .. } => inner_m,
+                _ => 0.0,
+            },
+            ranges_m: match self.region {
+                Region::Coverage { ranges_m, .. } => Some(ranges_m),
+                _ => None,
             },
         }
     }
@@ -175,7 +223,8 @@ impl WaveField {
     }
 
     /// A field from the flat layout, validated (the inverse of [`Self::flat_header`] and
-    /// [`Self::flat_rows`]).
+    /// [`Self::flat_rows`]; a coverage is seen from the reference point, and a disc with a blind zone
+    /// is a coverage of that radius all round).
     pub fn from_flat(h: FlatHeader, rows: impl IntoIterator<Item = [f64; 4]>) -> Result<WaveField> {
         let f = WaveField {
             components: rows
@@ -190,7 +239,13 @@ impl WaveField {
             time_s: h.time_s,
             g_m_s2: h.g_m_s2,
             depth_m: (h.depth_m > 0.0).then_some(h.depth_m),
-            region: if h.radius_m > 0.0 {
+            region: if h.radius_m > 0.0 && (h.ranges_m.is_some() || h.inner_m != 0.0) {
+                Region::Coverage {
+                    centre_m: h.reference_m,
+                    inner_m: h.inner_m,
+                    ranges_m: h.ranges_m.unwrap_or([h.radius_m; COVERAGE_SECTORS]),
+                }
+            } else if h.radius_m > 0.0 {
                 Region::Disc {
                     centre_m: h.reference_m,
                     radius_m: h.radius_m,
@@ -234,6 +289,19 @@ impl WaveField {
             && !(h.is_finite() && h > 0.0)
         {
             return Err(Error::Invalid(format!("depth {h} m: must be positive")));
+        }
+        if let Region::Coverage { inner_m, ranges_m, .. } = self.region {
+            if !(inner_m.is_finite() && inner_m >= 0.0) {
+                return Err(Error::Invalid(format!(
+                    "blind zone {inner_m} m: must be a finite number >= 0"
+                )));
+            }
+            if let Some(j) = ranges_m.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
+                return Err(Error::Invalid(format!(
+                    "coverage sector {j}: range {} m must be a finite number >= 0",
+                    ranges_m[j]
+                )));
+            }
         }
         Ok(())
     }
@@ -406,11 +474,83 @@ mod tests {
                 at_m: [100.0, -50.0],
                 window_s: 120.0,
             },
+            // a radar's view: a blind zone, a masked sector, shadows (fails before issue 28's
+            // coverage on the wire: read back as the disc of its farthest reach)
+            Region::Coverage {
+                centre_m: [100.0, -50.0],
+                inner_m: 190.0,
+                ranges_m: std::array::from_fn(|j| {
+                    if (30..38).contains(&j) {
+                        0.0
+                    } else {
+                        600.0 + 5.0 * j as f64
+                    }
+                }),
+            },
         ] {
             let f = WaveField { region, ..field() };
             let back = WaveField::from_flat(f.flat_header(), f.flat_rows()).unwrap();
             assert_eq!(back, f);
         }
+    }
+
+    #[test]
+    fn a_coverage_given_in_other_sectors_keeps_only_what_was_seen_all_across_ours() {
+        assert_eq!(coverage_from_sectors(&[]).unwrap(), None);
+        // 36 sectors of 10 deg: each of ours (5 deg) inside one of them
+        let coarse: Vec<f64> = (0..36).map(|i| 100.0 * i as f64).collect();
+        let ours = coverage_from_sectors(&coarse).unwrap().unwrap();
+        assert!((0..COVERAGE_SECTORS).all(|j| ours[j] == coarse[j / 2]), "{ours:?}");
+        // 144 sectors of 2.5 deg: the nearer of the two in each of ours
+        let fine: Vec<f64> = (0..144)
+            .map(|i| if i % 2 == 0 { 500.0 } else { 300.0 + i as f64 })
+            .collect();
+        let ours = coverage_from_sectors(&fine).unwrap().unwrap();
+        assert!(
+            (0..COVERAGE_SECTORS).all(|j| ours[j] == 301.0 + 2.0 * j as f64),
+            "{ours:?}"
+        );
+        // 7 sectors (51.4 deg): ours across a boundary takes the nearer
+        let seven = [900.0, 100.0, 900.0, 900.0, 900.0, 900.0, 900.0];
+        let ours = coverage_from_sectors(&seven).unwrap().unwrap();
+        // our sector 10 spans 50-55 deg, across the boundary at 51.4 deg
+        assert_eq!((ours[9], ours[10], ours[11]), (900.0, 100.0, 100.0));
+        // 72: as given
+        let same: Vec<f64> = (0..72).map(|i| i as f64).collect();
+        assert_eq!(coverage_from_sectors(&same).unwrap().unwrap().to_vec(), same);
+        for bad in [vec![f64::NAN; 72], vec![-1.0; 10], vec![1.0; MAX_GIVEN_SECTORS + 1]] {
+            assert!(coverage_from_sectors(&bad).is_err());
+        }
+        let err = coverage_from_sectors(&[5.0, 5.0, f64::INFINITY])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("coverage sector 2"), "{err}");
+    }
+
+    #[test]
+    fn a_disc_with_a_blind_zone_is_a_coverage_all_round() {
+        let f = field();
+        let h = FlatHeader {
+            radius_m: 900.0,
+            inner_m: 150.0,
+            ..f.flat_header()
+        };
+        let back = WaveField::from_flat(h, f.flat_rows()).unwrap();
+        assert_eq!(
+            back.region,
+            Region::Coverage {
+                centre_m: f.reference_m,
+                inner_m: 150.0,
+                ranges_m: [900.0; COVERAGE_SECTORS]
+            }
+        );
+        let bad = FlatHeader { inner_m: -1.0, ..h };
+        assert!(
+            WaveField::from_flat(bad, f.flat_rows())
+                .unwrap_err()
+                .to_string()
+                .contains("blind zone")
+        );
     }
 
     #[test]
