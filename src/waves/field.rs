@@ -135,12 +135,7 @@ pub fn coverage_from_sectors(given: &[f64]) -> Result<Option<[f64; COVERAGE_SECT
             "coverage in {n} sectors: at most {MAX_GIVEN_SECTORS}"
         )));
     }
-    if let Some(i) = given.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
-        return Err(Error::Invalid(format!(
-            "coverage sector {i}: range {} m must be a finite number >= 0",
-            given[i]
-        )));
-    }
+    check_ranges(given)?;
     Ok(Some(std::array::from_fn(|j| {
         // the given sectors overlapping [j, j + 1) of ours, in units of theirs (exact where n is a
         // multiple of COVERAGE_SECTORS or a divisor)
@@ -151,6 +146,18 @@ pub fn coverage_from_sectors(given: &[f64]) -> Result<Option<[f64; COVERAGE_SECT
             .iter()
             .fold(f64::INFINITY, |m, r| m.min(*r))
     })))
+}
+
+/// Every range of a coverage (m, per sector) a finite number >= 0; the error names the first that is
+/// not by its sector.
+fn check_ranges(ranges_m: &[f64]) -> Result<()> {
+    match ranges_m.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
+        Some(j) => Err(Error::Invalid(format!(
+            "coverage sector {j}: range {} m must be a finite number >= 0",
+            ranges_m[j]
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// Converts a compass heading (clockwise from north, degrees) to a direction counterclockwise from
@@ -189,6 +196,10 @@ impl WaveField {
     /// The header numbers of the flat layout ([`FlatHeader`]). A point region travels as the
     /// reference point (a probe's field is referred to its probe: `observe::from_probe`).
     pub fn flat_header(&self) -> FlatHeader {
+        let (inner_m, ranges_m) = match self.region {
+            Region::Coverage { inner_m, ranges_m, .. } => (inner_m, Some(ranges_m)),
+            _ => (0.0, None),
+        };
         FlatHeader {
             time_s: self.time_s,
             reference_m: self.reference_m,
@@ -204,14 +215,8 @@ impl WaveField {
                 Region::Point { window_s, .. } => window_s,
                 _ => 0.0,
             },
-            inner_m: match self.region {
-                Region::Coverage { inner_m, .. } => inner_m,
-                _ => 0.0,
-            },
-            ranges_m: match self.region {
-                Region::Coverage { ranges_m, .. } => Some(ranges_m),
-                _ => None,
-            },
+            inner_m,
+            ranges_m,
         }
     }
 
@@ -296,12 +301,7 @@ impl WaveField {
                     "blind zone {inner_m} m: must be a finite number >= 0"
                 )));
             }
-            if let Some(j) = ranges_m.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
-                return Err(Error::Invalid(format!(
-                    "coverage sector {j}: range {} m must be a finite number >= 0",
-                    ranges_m[j]
-                )));
-            }
+            check_ranges(&ranges_m)?;
         }
         Ok(())
     }
