@@ -50,7 +50,10 @@ fn benches(c: &mut Criterion) {
                 let table = ResponseTable::of(&model).expect("response table");
                 let known = vec![vec![[0.0, 60.0]; req.waves.len()]; 2];
                 let opts = SpreadOptions {
-                    model_error: ModelErrorCurve::prior(0.15, 12),
+                    model_error: ModelErrorCurve {
+                        checked_to_s: f64::INFINITY,
+                        ..ModelErrorCurve::prior(0.15, 12)
+                    },
                     trusted_nrmse: 0.6,
                     start_var: vec![],
                     start_offset: vec![],

@@ -557,7 +557,16 @@ fn a_python_console_decodes_a_live_forecast() {
         assert_eq!(l["steps"], (60.0 / dt_s).round() as u64);
         let h = l["vessels"][0]["heave_at_lead_s"]["30"].as_f64().unwrap();
         assert!(h.is_finite() && h.abs() < 10.0);
-        assert!(l["vessels"][0]["horizon_s"].as_f64().unwrap() > 30.0);
+        // a run's first forecasts: none checked yet against the motion that followed, nothing
+        // trusted, and the flag that says why (decoded by name in Python)
+        assert_eq!(l["vessels"][0]["horizon_s"].as_f64().unwrap(), 0.0);
+        let flags: Vec<&str> = l["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert!(flags.contains(&"model_error_unchecked"), "{flags:?}");
     }
     eprintln!("python decoded: {}", lines[0]);
 }

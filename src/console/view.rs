@@ -240,6 +240,10 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
             ("wave_region_unknown", "Radar: field without its region: not trusted"),
             ("no_wave_components", "Radar: an empty field: not trusted"),
             ("waves_dropped", "Part of the sea is outside the vessel database"),
+            (
+                "model_error_unchecked",
+                "Learning the model's error: no lead trusted until forecasts are checked",
+            ),
         ] {
             if h.flags.contains(&flag) {
                 out.push((Severity::Caution, words.into()));

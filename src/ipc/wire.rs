@@ -99,6 +99,10 @@ pub mod flags {
     /// Wave components meet the vessel at an encounter frequency below one cycle over the forecast
     /// (following seas at speed): kept, their force quasi-static.
     pub const QUASI_STATIC_WAVES: u32 = 32768;
+    /// No forecast has yet been checked against the motion that followed at any lead past 0 (the
+    /// first minute or so of a run): the model error is the configured prior's, and no lead is
+    /// trusted (horizon 0) until it has been checked.
+    pub const MODEL_ERROR_UNCHECKED: u32 = 65536;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -119,6 +123,7 @@ pub mod flags {
             (MOTION_RESTARTED, "motion_restarted"),
             (NAVIGATION_FALLBACK, "navigation_fallback"),
             (QUASI_STATIC_WAVES, "quasi_static_waves"),
+            (MODEL_ERROR_UNCHECKED, "model_error_unchecked"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)

@@ -24,11 +24,15 @@
 //! with e the model error as a fraction of the motion's own standard deviation (config
 //! `forecast.model_error` until [`ModelError`] has learnt it from the daemon's past forecasts), and
 //! k the band's scale, learnt from the same checks so that [`BAND_QUANTILE`] of them fall inside the
-//! 90 % band (errors are not normal; 1 until learnt), never narrower than the sensor's noise. The ratio sigma(t) / sqrt(sum_c v_c) is the
-//! normalized RMS error the forecast expects at t; a vessel's forecast is trusted over the longest run
+//! 90 % band (errors are not normal; 1 until learnt), never narrower than the sensor's noise. The ratio sigma(t) / (k(t) sqrt(sum_c v_c)) is the
+//! normalized RMS error the forecast expects at t (the scale is the band's, for its coverage: for
+//! the narrow-band errors of a resonant roll it is about 0.85); a vessel's forecast is trusted over the longest run
 //! of leads (the earliest of equal ones) at which that ratio is at most `forecast.trusted_nrmse` for
-//! each of heave, roll and pitch that moves enough to matter ([`SIGNIFICANT`]): the initial state can
-//! make the first seconds trusted and a radar's blind zone the next ones not.
+//! each of heave, roll and pitch that moves enough to matter ([`SIGNIFICANT`]), with the learnt e^2
+//! taken [`SPAN_CONFIDENCE_Z`] of its standard errors up (a span opens where the error is known to be
+//! small), and none past the leads at which it has been learnt (a prior no forecast has been checked
+//! against opens no span): the initial state can make the first seconds trusted and a radar's blind
+//! zone the next ones not.
 //!
 //! Conventions (DESIGN.md section 1): DOF order surge, sway, heave, roll, pitch, yaw per vessel, m and
 //! rad; headings of waves relative to the vessel's +x, travel-to, counterclockwise; series-major output
@@ -294,6 +298,9 @@ pub fn spread(
         }
     }
     let mut sigma = Vec::with_capacity(n_series * n);
+    // the expected RMS error the span judges: unscaled, the learnt model error SPAN_CONFIDENCE_Z
+    // standard errors up
+    let mut span_sigma = Vec::with_capacity(n_series * n);
     for i in 0..n_series {
         let noise_var = opts.model_error.noise_var.get(i).copied().unwrap_or(0.0);
         let start0 = opts
@@ -322,10 +329,22 @@ pub fn spread(
             let scale = opts.model_error.scale_at(i, learnt_lead_s);
             // never narrower than the start's own random error (a forecast is no surer than its
             // start; the checks against the measured motion cannot resolve less than its noise)
-            let learnt = (((acc + rate * k as f64).max(0.0) + floor) * scale * scale).max(start0);
+            let unknown = (acc + rate * k as f64).max(0.0);
+            let learnt = ((unknown + floor) * scale * scale).max(start0);
             let r = after_start(lead_s);
             let var = r * learnt + (1.0 - r) * sigma0 * sigma0;
             sigma.push(var.sqrt());
+            // the span judges the error's expected mean square, not the band: the band's scale
+            // makes it hold nine checks in ten (narrow-band errors, a resonant roll's, have their
+            // 90 % quantile at 1.4 RMS, not 1.645: a band of 0.85 RMS); and the learnt model error
+            // as it may be, not as estimated; and nothing past the leads it has been checked at
+            let se = opts.model_error.var_se_at(i, learnt_lead_s);
+            let mean_square = (unknown + floor + SPAN_CONFIDENCE_Z * se).max(start0);
+            span_sigma.push(if learnt_lead_s <= opts.model_error.checked_to_s {
+                (r * mean_square + (1.0 - r) * sigma0 * sigma0).sqrt()
+            } else {
+                f64::INFINITY
+            });
         }
     }
     let motion_sigma: Vec<f64> = total.iter().map(|t| t.sqrt()).collect();
@@ -344,7 +363,7 @@ pub fn spread(
         let trusted = |k: usize| {
             decisive
                 .iter()
-                .all(|&i| sigma[i * n + k] <= opts.trusted_nrmse * judged[i])
+                .all(|&i| span_sigma[i * n + k] <= opts.trusted_nrmse * judged[i])
         };
         if let Some((first, last)) = longest_run((0..=n.saturating_sub(1)).map(trusted)) {
             from_s[b] = first as f64 * dt_s;
@@ -399,6 +418,18 @@ const Z90: f64 = 1.6448536269514722;
 /// The band's learnt scale stays within these (a few odd checks do not collapse or blow it up).
 const BAND_SCALE_LIMITS: (f64, f64) = (0.5, 3.0);
 
+/// The learnt model error's own uncertainty is told by batch means: the checks at a lead are
+/// averaged in batches of this many (longer than a check's squared error stays correlated with the
+/// next ones': 10-60 forecasts a second apart in the two-ship demo's default sea) ...
+const BATCH_CHECKS: usize = 60;
+/// ... the last this many batches kept (the [`CHECK_MEMORY`] checks the estimate follows).
+const BATCHES: usize = (CHECK_MEMORY as usize) / BATCH_CHECKS;
+/// The trusted span judges the learnt model error this many of its standard errors above the
+/// estimate (one-sided, 84 %): a span opens where the error is known to be small, not where a
+/// noisy estimate of it happens to read small (with 600 checks correlated over tens of them the
+/// estimate's own spread is 25-45 % of it).
+pub const SPAN_CONFIDENCE_Z: f64 = 1.0;
+
 /// The smallest model error the estimate gives (a forecast is never taken as perfect).
 const MIN_MODEL_ERROR: f64 = 0.02;
 /// A series' measured motion counts (judges the span, floors the model error) only where its variance
@@ -452,6 +483,10 @@ pub struct ModelError {
     mean: Vec<f64>,
     square: Vec<f64>,
     samples: usize,
+    /// [lead][series]: the sum of error^2 less what is explained over the open batch of checks, and
+    /// the means of the last closed batches ([`BATCH_CHECKS`] each), newest last.
+    batch_sum: Vec<Vec<f64>>,
+    batch_means: Vec<Vec<std::collections::VecDeque<f64>>>,
 }
 
 /// The model error of each series against lead, and the motion's measured variance.
@@ -470,6 +505,12 @@ pub struct ModelErrorCurve {
     /// `scale[series][lead]`: the band's factor that makes [`BAND_QUANTILE`] of the checks fall
     /// inside its 90 % (NaN: not learnt, 1).
     pub scale: Vec<Vec<f64>>,
+    /// `var_se[series][lead]`: the standard error of `var` (batch means of the checks; one batch
+    /// alone: `var` itself), m^2 or rad^2 (NaN: not learnt, 0).
+    pub var_se: Vec<Vec<f64>>,
+    /// The span trusts no lead past this one, s: the model error has been learnt at every check lead
+    /// up to it (0: at none yet, the prior alone, which no forecast has been checked against).
+    pub checked_to_s: f64,
 }
 
 impl ModelErrorCurve {
@@ -482,6 +523,8 @@ impl ModelErrorCurve {
             motion_var: vec![f64::NAN; n_series],
             noise_var: vec![0.0; n_series],
             scale: vec![vec![f64::NAN]; n_series],
+            var_se: vec![vec![f64::NAN]; n_series],
+            checked_to_s: 0.0,
         }
     }
 
@@ -500,6 +543,12 @@ impl ModelErrorCurve {
         let grown = self.prior * (lead_s / PRIOR_LEAD_S).max(1.0);
         let prior = grown * grown * model_motion_var;
         along_leads(&self.lead_s, self.var.get(i), lead_s, prior)
+    }
+
+    /// The standard error of series i's learnt model error variance at `lead_s`: linear between the
+    /// check leads, constant beyond them, 0 where not learnt.
+    pub fn var_se_at(&self, i: usize, lead_s: f64) -> f64 {
+        along_leads(&self.lead_s, self.var_se.get(i), lead_s, 0.0)
     }
 
     /// Series i's band scale at `lead_s`: linear between the check leads, constant beyond them, 1 where
@@ -615,6 +664,8 @@ impl ModelError {
             mean: vec![0.0; n_series],
             square: vec![0.0; n_series],
             samples: 0,
+            batch_sum: vec![vec![0.0; n_series]; CHECK_LEADS_S.len()],
+            batch_means: vec![vec![Default::default(); n_series]; CHECK_LEADS_S.len()],
         }
     }
 
@@ -630,7 +681,7 @@ impl ModelError {
 
     /// What has been learnt.
     pub fn curve(&self) -> ModelErrorCurve {
-        let var = (0..self.n_series)
+        let var: Vec<Vec<f64>> = (0..self.n_series)
             .map(|i| {
                 (0..CHECK_LEADS_S.len())
                     .map(|j| {
@@ -671,9 +722,36 @@ impl ModelError {
                     .collect()
             })
             .collect();
+        // the standard error of each learnt variance: the spread of its batch means over the root
+        // of their number (errors correlated over less than a batch leave the batches independent)
+        let var_se = var
+            .iter()
+            .enumerate()
+            .map(|(i, row)| {
+                row.iter()
+                    .enumerate()
+                    .map(|(j, v)| {
+                        let means = &self.batch_means[j][i];
+                        let nb = means.len() as f64;
+                        if v.is_nan() || nb < 2.0 {
+                            return *v;
+                        }
+                        let mean = means.iter().sum::<f64>() / nb;
+                        let square = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (nb - 1.0);
+                        (square / nb).sqrt()
+                    })
+                    .collect()
+            })
+            .collect();
+        let checked_to_s = (1..CHECK_LEADS_S.len())
+            .take_while(|&j| self.checks[j] >= CHECK_MIN)
+            .last()
+            .map_or(0.0, |j| CHECK_LEADS_S[j]);
         ModelErrorCurve {
             lead_s: CHECK_LEADS_S.to_vec(),
             var,
+            var_se,
+            checked_to_s,
             scale,
             prior: self.prior,
             motion_var: (0..self.n_series).map(|i| self.motion_var(i)).collect(),
@@ -798,6 +876,7 @@ impl ModelError {
                     let noise = p.check_var[i];
                     let explained = p.unknown_var[j][i] + noise;
                     self.excess[j][i] += w * (e2 - explained - self.excess[j][i]);
+                    self.batch_sum[j][i] += e2 - explained;
                     let band = p.raw_sigma[j][i];
                     if band > 0.0 && band.is_finite() {
                         let z = &mut self.normalized[j][i];
@@ -805,6 +884,16 @@ impl ModelError {
                         if z.len() > CHECK_MEMORY as usize {
                             z.pop_front();
                         }
+                    }
+                }
+                if j > 0 && self.checks[j].is_multiple_of(BATCH_CHECKS) {
+                    for i in 0..self.n_series {
+                        let means = &mut self.batch_means[j][i];
+                        means.push_back(self.batch_sum[j][i] / BATCH_CHECKS as f64);
+                        if means.len() > BATCHES {
+                            means.pop_front();
+                        }
+                        self.batch_sum[j][i] = 0.0;
                     }
                 }
                 if j == 0 {
@@ -849,6 +938,14 @@ pub fn band_z(probability: f64) -> f64 {
 mod tests {
     use super::*;
     use num_complex::Complex64;
+
+    /// A curve whose model error is taken as checked at every lead (the span may trust any).
+    fn checked(curve: ModelErrorCurve) -> ModelErrorCurve {
+        ModelErrorCurve {
+            checked_to_s: f64::INFINITY,
+            ..curve
+        }
+    }
 
     fn flat_table(n_modes: usize, gain: f64) -> ResponseTable {
         ResponseTable {
@@ -1096,7 +1193,7 @@ mod tests {
         ];
         let known = vec![vec![[0.0, 60.0], [20.0, 40.0]]];
         let opts = SpreadOptions {
-            model_error: ModelErrorCurve::prior(0.1, 6),
+            model_error: checked(ModelErrorCurve::prior(0.1, 6)),
             trusted_nrmse: 0.6,
             start_var: vec![],
             start_offset: vec![],
@@ -1119,6 +1216,142 @@ mod tests {
         assert!((heave[25] - expect(0.0)).abs() < 1e-12);
         assert_eq!((s.from_s[0], s.to_s[0]), (24.0, 40.0));
         assert!((s.motion_sigma[2] - 1.0).abs() < 1e-12);
+    }
+
+    /// Forecasts of 5 s (steps of 0.5 s) of six series, heave moving +-1 and forecast with an error
+    /// at 5 s of `amplitude(check)` (the others still): the model error learnt, and the span of a
+    /// forecast made with it.
+    fn span_after_checks(amplitude: impl Fn(usize) -> f64) -> (ModelErrorCurve, Spread) {
+        let mut m = ModelError::new(0.1, vec![0.0; 6]);
+        let prior = ModelErrorCurve::prior(0.1, 6);
+        let (dt, n) = (0.5, 11);
+        let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
+        let sigma = vec![0.0; 6 * n];
+        for c in 0..605 {
+            let t0 = c as f64;
+            let mut values = vec![0.0; 6 * n];
+            for k in 0..n {
+                values[2 * n + k] = motion(t0 + k as f64 * dt);
+            }
+            // the error at 5 s, its sign alternating
+            values[2 * n + 10] -= amplitude(c) * if c % 2 == 0 { 1.0 } else { -1.0 };
+            m.record(t0, dt, (&values, &sigma), &[1.0; 6], &prior, (&[], &[]));
+            m.observe(t0, |at| {
+                Some((0..6).map(|i| if i == 2 { motion(at) } else { 0.0 }).collect())
+            });
+        }
+        let curve = m.curve();
+        let opts = SpreadOptions {
+            model_error: curve.clone(),
+            trusted_nrmse: 0.6,
+            start_var: vec![],
+            start_offset: vec![],
+        };
+        let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, n - 1, dt, &opts);
+        (curve, s)
+    }
+
+    #[test]
+    fn a_span_opens_where_the_model_error_is_known_to_be_small_not_where_its_estimate_reads_small() {
+        // heave's error at 5 s is 0.2 over one minute of checks and 0.75 over the next, in turn: its
+        // mean square 0.30 (an expected NRMSE of 0.55, under 0.6), but known only to within a
+        // standard error of 0.087 (ten minutes, ten batches: 0.39 at one standard error up, an NRMSE
+        // of 0.62). Fails before the span judged the learnt error's uncertainty (trusted to 5 s).
+        let (curve, s) = span_after_checks(|c| if (c / BATCH_CHECKS).is_multiple_of(2) { 0.2 } else { 0.75 });
+        let mean_square = 0.5 * (0.04 + 0.5625);
+        assert!((curve.var[2][1] - mean_square).abs() < 1e-9, "{:?}", curve.var[2]);
+        let se = 0.26125 * (10.0f64 / 9.0).sqrt() / 10.0f64.sqrt();
+        assert!((curve.var_se[2][1] - se).abs() < 1e-9, "{:?}", curve.var_se[2]);
+        // the band is the estimate's; the span is not
+        assert!((s.sigma[2 * 11 + 10] - mean_square.sqrt()).abs() < 1e-9);
+        // judged at sqrt(r (0.301 + 0.087)) with r = lead / 5 s: trusted while r <= 0.928
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 4.5));
+        // the same mean square every minute: known as well as estimated, trusted throughout
+        let (curve, s) = span_after_checks(|_| mean_square.sqrt());
+        assert!(curve.var_se[2][1].abs() < 1e-9, "{:?}", curve.var_se[2]);
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 5.0));
+    }
+
+    #[test]
+    fn a_span_trusts_no_lead_its_model_error_has_not_been_checked_at() {
+        // nothing checked yet: the configured prior alone (0.15 of the motion), however small, opens
+        // no span; forecasts of 10 s checked at 0, 5 and 10 s with an error of 0.1: trusted to 10 s
+        // and no further (fails before: the prior's 0.15 trusted throughout)
+        let opts = |model_error| SpreadOptions {
+            model_error,
+            trusted_nrmse: 0.6,
+            start_var: vec![],
+            start_offset: vec![],
+        };
+        let mut moving = ModelErrorCurve::prior(0.15, 6);
+        moving.motion_var[2] = 1.0;
+        let s = spread(
+            &flat_table(6, 1.0),
+            &[],
+            &[],
+            1,
+            0.0,
+            9.81,
+            None,
+            40,
+            0.5,
+            &opts(moving),
+        );
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 0.0));
+        let mut m = ModelError::new(0.15, vec![0.0; 6]);
+        let prior = ModelErrorCurve::prior(0.15, 6);
+        let (dt, n) = (0.5, 21);
+        let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
+        for c in 0..200 {
+            let t0 = c as f64;
+            let mut values = vec![0.0; 6 * n];
+            for k in 0..n {
+                values[2 * n + k] = motion(t0 + k as f64 * dt) - if k > 0 { 0.1 } else { 0.0 };
+            }
+            m.record(t0, dt, (&values, &vec![0.0; 6 * n]), &[1.0; 6], &prior, (&[], &[]));
+            m.observe(t0, |at| {
+                Some((0..6).map(|i| if i == 2 { motion(at) } else { 0.0 }).collect())
+            });
+        }
+        let s = spread(
+            &flat_table(6, 1.0),
+            &[],
+            &[],
+            1,
+            0.0,
+            9.81,
+            None,
+            40,
+            0.5,
+            &opts(m.curve()),
+        );
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 10.0));
+    }
+
+    #[test]
+    fn the_span_judges_the_expected_rms_error_not_the_band_scaled_for_its_coverage() {
+        // heave moving 1 m; its learnt model error 0.42 m^2 at every lead (an expected NRMSE of
+        // 0.65), the band scaled by 0.8 to hold nine checks in ten (errors as narrow-band as a
+        // roll's: their 90 % quantile 1.3 RMS): the band is 0.52 m, the error it expects is not.
+        // Fails before the span judged the unscaled error (trusted throughout, 0.52 <= 0.6).
+        let mut curve = ModelErrorCurve::prior(0.1, 6);
+        curve.lead_s = CHECK_LEADS_S.to_vec();
+        curve.var[2] = vec![0.42; CHECK_LEADS_S.len()];
+        curve.scale[2] = vec![0.8; CHECK_LEADS_S.len()];
+        curve.motion_var = vec![0.0; 6];
+        curve.motion_var[2] = 1.0;
+        curve.checked_to_s = f64::INFINITY;
+        let opts = SpreadOptions {
+            model_error: curve,
+            trusted_nrmse: 0.6,
+            start_var: vec![],
+            start_offset: vec![],
+        };
+        let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, 20, 0.5, &opts);
+        assert!((s.sigma[2 * 21 + 10] - 0.42f64.sqrt() * 0.8).abs() < 1e-12);
+        // the start's band is 0 (no start error given, no noise), then runs linearly in variance to
+        // the learnt: r = lead / 5 s <= 0.36 / 0.42 up to 4 s
+        assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 4.0));
     }
 
     #[test]
@@ -1147,7 +1380,7 @@ mod tests {
             amplitude_m: Complex64::new(1.0, 0.0),
         }];
         let opts = SpreadOptions {
-            model_error: ModelErrorCurve::prior(0.0, 6),
+            model_error: checked(ModelErrorCurve::prior(0.0, 6)),
             trusted_nrmse: 0.6,
             start_var: vec![],
             start_offset: vec![],
@@ -1191,7 +1424,7 @@ mod tests {
             amplitude_m: Complex64::new(f64::NAN, 0.0),
         }];
         let opts = SpreadOptions {
-            model_error: ModelErrorCurve::prior(0.1, 6),
+            model_error: checked(ModelErrorCurve::prior(0.1, 6)),
             trusted_nrmse: 0.6,
             start_var: vec![],
             start_offset: vec![],

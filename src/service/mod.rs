@@ -1255,6 +1255,10 @@ impl Engine {
                             .collect()
                     })
                     .collect();
+                let model_error = self.model_error.curve();
+                if model_error.checked_to_s <= 0.0 {
+                    header.flags |= flags::MODEL_ERROR_UNCHECKED;
+                }
                 fl = header.flags;
                 self.busy = true;
                 self.job_offset = offset;
@@ -1268,7 +1272,7 @@ impl Engine {
                     waves,
                     known_leads,
                     trustworthy,
-                    model_error: self.model_error.curve(),
+                    model_error,
                     start_var,
                     start_offset,
                     check_var,

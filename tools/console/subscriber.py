@@ -45,6 +45,7 @@ FLAGS = [
     "motion_restarted",
     "navigation_fallback",
     "quasi_static_waves",
+    "model_error_unchecked",
 ]
 
 
