@@ -1257,7 +1257,13 @@ mod tests {
         // mean square 0.30 (an expected NRMSE of 0.55, under 0.6), but known only to within a
         // standard error of 0.087 (ten minutes, ten batches: 0.39 at one standard error up, an NRMSE
         // of 0.62). Fails before the span judged the learnt error's uncertainty (trusted to 5 s).
-        let (curve, s) = span_after_checks(|c| if (c / BATCH_CHECKS).is_multiple_of(2) { 0.2 } else { 0.75 });
+        let (curve, s) = span_after_checks(|c| {
+            if (c / BATCH_CHECKS).is_multiple_of(2) {
+                0.2
+            } else {
+                0.75
+            }
+        });
         let mean_square = 0.5 * (0.04 + 0.5625);
         assert!((curve.var[2][1] - mean_square).abs() < 1e-9, "{:?}", curve.var[2]);
         let se = 0.26125 * (10.0f64 / 9.0).sqrt() / 10.0f64.sqrt();
