@@ -573,6 +573,24 @@ fn after_start(lead_s: f64) -> f64 {
     (lead_s / CHECK_LEADS_S[1]).clamp(0.0, 1.0)
 }
 
+/// The variance of a heel (rad^2), from the running mean square `mean_square` of a DOF's measured mean
+/// offset over `memory_s`, of which the sensor's drift (variance `held`, correlation `drift_time_s`)
+/// explains `held`: what is left is heel, counted only beyond one standard error of that mean square
+/// (held sqrt(drift_time_s / memory_s): a few draws of the drift are all `memory_s` holds; `memory_s`
+/// taken as at least one `drift_time_s`, as one draw is), so that a large draw of the drift is not
+/// taken for heel. Infinite (nothing known) where `memory_s` is not positive; 0 where an input is not
+/// finite.
+pub fn heel_var(mean_square: f64, held: f64, drift_time_s: f64, memory_s: f64) -> f64 {
+    if !(memory_s > 0.0) {
+        return f64::INFINITY;
+    }
+    let held = held.max(0.0);
+    let drift_time_s = drift_time_s.max(0.0);
+    let se = held * (drift_time_s / memory_s.max(drift_time_s)).sqrt();
+    let v = (mean_square - held - se).max(0.0);
+    if v.is_finite() { v } else { 0.0 }
+}
+
 /// The expected error of a forecast's start and the variance of what is unknown of it, for a DOF whose
 /// measured mean is `measured` (rad) off the model's and of which the forecast leaves `left` out as
 /// the sensor's bias: the measured offset is heel H plus the sensor's bias average S, independent,
@@ -1068,6 +1086,23 @@ mod tests {
         // halfway to it, half of each variance
         let mid = (0.5 * 4e-6 + 0.5 * (h / Z90).powi(2)).sqrt();
         assert!((s.sigma[5] - mid).abs() < 1e-9, "{} {mid}", s.sigma[5]);
+    }
+
+    #[test]
+    fn a_heel_is_counted_beyond_what_the_drift_may_draw() {
+        // memory of 900 s against a drift of 600 s: one standard error of the mean square is
+        // held sqrt(2/3); within held (1 + that), no heel
+        let held = 1e-8;
+        let se = held * (600.0f64 / 900.0).sqrt();
+        assert_eq!(heel_var(held + 0.9 * se, held, 600.0, 900.0), 0.0);
+        assert!((heel_var(held + se + 3e-8, held, 600.0, 900.0) - 3e-8).abs() < 1e-20);
+        // no drift: all of it heel
+        assert_eq!(heel_var(4e-8, 0.0, 600.0, 900.0), 4e-8);
+        assert_eq!(heel_var(4e-8, held, 600.0, 0.0), f64::INFINITY);
+        assert_eq!(heel_var(f64::NAN, held, 600.0, 900.0), 0.0);
+        // less than one correlation time seen: one standard error is held itself
+        assert_eq!(heel_var(2.0 * held, held, 600.0, 60.0), 0.0);
+        assert!((heel_var(5e-8, held, 600.0, 60.0) - 3e-8).abs() < 1e-20);
     }
 
     #[test]

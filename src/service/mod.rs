@@ -680,6 +680,8 @@ pub struct Engine {
     heel_square: Vec<estimator::RunningMean>,
     heel_time_s: Option<f64>,
     bias_time_s: f64,
+    /// `estimator.drift_time_s`.
+    drift_time_s: f64,
     /// `estimator.angle_bias_rad`.
     angle_bias_rad: f64,
     /// Per vessel and DOF, what the running job's forecast is shifted by when done: for
@@ -756,6 +758,7 @@ impl Engine {
             job_offset: vec![[0.0; 6]; n_bodies],
             job_unknown: vec![false; n_bodies],
             bias_time_s: cfg.estimator.bias_time_s,
+            drift_time_s: cfg.estimator.drift_time_s,
             angle_bias_rad: cfg.estimator.angle_bias_rad,
             model_error: spread::ModelError::new(
                 cfg.forecast.model_error,
@@ -1110,11 +1113,14 @@ impl Engine {
                     if bias[d] != 0.0 {
                         let m = bias[d] - self.model_mean[b].value[d];
                         square[d] = m * m;
-                        let heel_var = if self.heel_square[b].span_s > 0.0 {
-                            (self.heel_square[b].value[d] - held[d]).max(0.0)
-                        } else {
-                            f64::INFINITY
-                        };
+                        let heel_var = spread::heel_var(
+                            self.heel_square[b].value[d],
+                            held[d],
+                            self.drift_time_s,
+                            self.heel_square[b]
+                                .span_s
+                                .min(HEEL_MEMORY_BIAS_TIMES * self.bias_time_s),
+                        );
                         let (mean, var) = spread::heel_split(m, m - offset[b][d], held[d], heel_var);
                         start_offset[6 * b + d] = mean;
                         start_var[6 * b + d] += var;
