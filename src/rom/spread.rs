@@ -581,7 +581,7 @@ fn after_start(lead_s: f64) -> f64 {
 /// taken for heel. Infinite (nothing known) where `memory_s` is not positive; 0 where an input is not
 /// finite.
 pub fn heel_var(mean_square: f64, held: f64, drift_time_s: f64, memory_s: f64) -> f64 {
-    if !(memory_s > 0.0) {
+    if memory_s.is_nan() || memory_s <= 0.0 {
         return f64::INFINITY;
     }
     let held = held.max(0.0);
