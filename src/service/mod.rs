@@ -1108,6 +1108,7 @@ impl Engine {
                 // tells apart; the band holds either, as likely as the sensor's drift and the
                 // offsets seen so far make them (`spread::heel_split`)
                 let held = self.hist[b].drift_in_bias_var();
+                let heel_memory_s = HEEL_MEMORY_BIAS_TIMES * self.bias_time_s;
                 let mut square = [f64::NAN; 6];
                 for d in MEASURED_MEAN_DOFS {
                     if bias[d] != 0.0 {
@@ -1117,16 +1118,14 @@ impl Engine {
                             self.heel_square[b].value[d],
                             held[d],
                             self.drift_time_s,
-                            self.heel_square[b]
-                                .span_s
-                                .min(HEEL_MEMORY_BIAS_TIMES * self.bias_time_s),
+                            self.heel_square[b].span_s.min(heel_memory_s),
                         );
                         let (mean, var) = spread::heel_split(m, m - offset[b][d], held[d], heel_var);
                         start_offset[6 * b + d] = mean;
                         start_var[6 * b + d] += var;
                     }
                 }
-                self.heel_square[b].add(heel_dt, &square, HEEL_MEMORY_BIAS_TIMES * self.bias_time_s);
+                self.heel_square[b].add(heel_dt, &square, heel_memory_s);
             }
             if ok {
                 // past forecasts against the motion that followed them, as measured, with the sensor's
