@@ -8,8 +8,8 @@
 //! table) is outside the timing.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use shipcast::band::{ModelErrorCurve, ResponseTable, SpreadOptions, spread};
 use shipcast::files::load_system;
-use shipcast::rom::spread::{ModelErrorCurve, ResponseTable, SpreadOptions, spread};
 use shipcast::rom::stepper::Stepper;
 use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel, Track};
 use shipcast::scenario::{Prepared, Scenario, past_options, prepare};

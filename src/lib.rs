@@ -8,7 +8,9 @@
 // Index loops read like the matrix formulas they implement (i, j, k as in the equations).
 #![allow(clippy::needless_range_loop)]
 
+pub mod band;
 pub mod console;
+pub mod engine;
 pub mod files;
 pub mod hydro;
 pub mod ipc;

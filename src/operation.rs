@@ -238,7 +238,7 @@ pub fn inside(values: &[&[f64]], limits: &[f64]) -> Vec<bool> {
 /// Whether every channel is inside its limit with at least `confidence` probability, sample by
 /// sample, each channel normal with mean `values[c][k]` and standard deviation `sigmas[c][k]` (an
 /// empty `sigmas[c]`: none). The probability that some channel is outside is at most the sum of
-/// each one's ([`crate::rom::spread::exceedance`]; no assumption on how they move together).
+/// each one's ([`crate::band::exceedance`]; no assumption on how they move together).
 pub fn inside_with_confidence(values: &[&[f64]], sigmas: &[&[f64]], limits: &[f64], confidence: f64) -> Vec<bool> {
     let n = values.iter().map(|v| v.len()).min().unwrap_or(0);
     (0..n)
@@ -252,7 +252,7 @@ pub fn inside_with_confidence(values: &[&[f64]], sigmas: &[&[f64]], limits: &[f6
                 if !sd.is_finite() {
                     return false;
                 }
-                p += crate::rom::spread::exceedance(v[k], sd, *l);
+                p += crate::band::exceedance(v[k], sd, *l);
             }
             p <= 1.0 - confidence
         })

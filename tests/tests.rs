@@ -23,6 +23,7 @@ mod link;
 mod replay;
 mod rom;
 mod sim_truth;
+mod tidy;
 mod trust;
 mod two_ship_demo;
 mod underway;

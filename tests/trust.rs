@@ -66,6 +66,9 @@ fn after(run: &Run, t0: f64, after_s: f64) -> Vec<&ForecastHeader> {
         .collect()
 }
 
+/// A horizon is a step's lead, steps * dt: what the product may round beyond the forecast's length, s.
+const HORIZON_ROUNDING_S: f64 = 1e-9;
+
 /// The invariants every output keeps, whatever the input: finite values and horizons, a horizon
 /// no longer than the forecast, ages never negative.
 fn invariants(run: &Run) {
@@ -74,7 +77,10 @@ fn invariants(run: &Run) {
         let len = h.steps as f64 * h.dt_s;
         for hz in &h.horizon_s[..h.n_vessels as usize] {
             assert!(hz.is_finite() && *hz >= 0.0, "horizon {hz}");
-            assert!(*hz <= len + 1e-9 || *hz <= 1e4, "horizon {hz} beyond any field");
+            assert!(
+                *hz <= len + HORIZON_ROUNDING_S,
+                "horizon {hz} s beyond the forecast's {len} s"
+            );
         }
     }
     for s in &run.statuses {
@@ -85,6 +91,22 @@ fn invariants(run: &Run) {
         );
         assert!(s.horizon_s.iter().all(|h| h.is_finite()), "{:?}", s.horizon_s);
     }
+}
+
+#[test]
+#[should_panic(expected = "beyond the forecast")]
+fn the_invariants_fail_on_a_horizon_longer_than_the_forecast() {
+    let h = ForecastHeader {
+        n_vessels: 1,
+        steps: 100,
+        dt_s: 0.1,
+        horizon_s: [10.5, 0.0, 0.0, 0.0],
+        ..ForecastHeader::default()
+    };
+    invariants(&Run {
+        forecasts: vec![(h, vec![0.0; 12])],
+        statuses: vec![],
+    });
 }
 
 fn baseline() -> &'static Run {
@@ -420,6 +442,12 @@ fn a_replay_of_more_vessels_than_the_payloads_carry_is_refused() {
     );
 }
 
+/// The share of the variance the added component holds: as much as all the others.
+const HALF_THE_SEA: f64 = 0.5;
+/// What the share may differ from that by: the field's own weakest components pruned
+/// (`forecast.wave_variance_kept`) and any at the database's edges.
+const SHARE_TOL: f64 = 0.05;
+
 /// Was: wave components outside the database's frequencies were dropped with nothing in the flags.
 #[test]
 fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_trusted() {
@@ -442,7 +470,7 @@ fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_truste
         assert_eq!(h.horizon_s[0], 0.0, "half the sea left out, yet trusted");
     }
     let share = run.statuses.last().unwrap().dropped_wave_share;
-    assert!((share - 0.5).abs() < 0.05, "{share}");
+    assert!((share - HALF_THE_SEA).abs() < SHARE_TOL, "{share}");
 }
 
 /// A fault put into one record of the log.

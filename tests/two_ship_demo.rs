@@ -104,6 +104,9 @@ fn log_forecasts() -> &'static [Forecast] {
     FS.get_or_init(|| forecasts(shipcast::rom::drift::DRIFT_WINDOW_S))
 }
 
+/// Forecasts per second of log, at least: the demo issues one a second, the rest a margin for the start.
+const MIN_FORECASTS_PER_S: f64 = 0.9;
+
 fn forecasts_of(l: &SimLog, drift_window_s: f64) -> Vec<Forecast> {
     let mut cfg = l.cfg.clone();
     cfg.forecast.drift_window_s = drift_window_s;
@@ -121,7 +124,11 @@ fn forecasts_of(l: &SimLog, drift_window_s: f64) -> Vec<Forecast> {
     )
     .unwrap();
     let log_s = l.records.last().unwrap().0 - l.records.first().unwrap().0;
-    assert!(out.len() as f64 > 0.9 * log_s, "{} forecasts", out.len());
+    assert!(
+        out.len() as f64 > MIN_FORECASTS_PER_S * log_s,
+        "{} forecasts",
+        out.len()
+    );
     out
 }
 
@@ -203,14 +210,14 @@ fn a_moored_vessel_s_forecast_starts_from_its_mean_heel() {
 }
 
 /// Roll and pitch of both vessels at lead 0 in the shipped sea (where they move enough to matter,
-/// `spread::SIGNIFICANT`), RMS error over the truth's standard deviation in the log's second half, at
+/// `band::SIGNIFICANT`), RMS error over the truth's standard deviation in the log's second half, at
 /// most: the truth (another model of the hulls) heels the
 /// moored lighter by about 0.5 deg more than the model does, and the forecast keeps the measured
 /// heel (measured at most 0.05; the lighter's roll 0.35 when the forecast took the model's own mean).
 const MEASURED_HEEL_NRMSE: f64 = 0.1;
 /// ... and the truth inside the published 90 % band at lead 0 in at least this share of them. Not the
 /// Show's 0.85: the 210 s judged are a third of the sensor's drift's correlation time, so they see one
-/// draw of it, and a band right over many draws (`spread::tests::the_band_at_the_start_covers_nine_
+/// draw of it, and a band right over many draws (`band::tests::the_band_at_the_start_covers_nine_
 /// in_ten_when_heel_and_bias_are_as_likely_as_said`) covers less where that draw is large; here the
 /// carrier's IMU reads 0.0002 rad low throughout (0.8 of the drift's standard deviation the bias
 /// average holds). Measured 0.74 (carrier) and 0.92 (lighter, its 3.3 deg heel kept); 0.56-0.66 for
@@ -238,7 +245,7 @@ fn a_heel_the_model_does_not_know_is_kept() {
                 .collect();
             let mean = truth.iter().sum::<f64>() / truth.len() as f64;
             let std = (truth.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / truth.len() as f64).sqrt();
-            if std < shipcast::rom::spread::SIGNIFICANT[d - 2] {
+            if std < shipcast::band::SIGNIFICANT[d - 2] {
                 // a DOF the sea barely moves (the carrier's pitch in beam seas): its error is the
                 // sensor's noise, not a measure of the heel kept
                 eprintln!(

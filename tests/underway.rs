@@ -36,6 +36,9 @@ fn component(omega_rad_s: f64, heading_deg: f64, re: f64, im: f64) -> WaveCompon
     }
 }
 
+/// Round-off only: the force of a component met at w_e = 0 is the same constant Re{X a} at every step.
+const ZERO_ENCOUNTER_FORCE_TOL: f64 = 1e-9;
+
 /// Was: the forecast had no track and no count of the components met at (near) zero encounter
 /// frequency; a following sea at w = g / U (deep water: k U = w) meets the vessel at w_e = 0.
 #[test]
@@ -75,10 +78,15 @@ fn a_following_sea_met_at_zero_encounter_frequency_gives_a_finite_forecast_and_i
         .flat_map(|row| row.iter().zip(&force[..n]).map(|(a, b)| (a - b).abs()))
         .fold(0.0f64, f64::max);
     assert!(
-        worst <= 1e-9 * scale,
+        worst <= ZERO_ENCOUNTER_FORCE_TOL * scale,
         "the force at w_e = 0 varies by {worst} of {scale}"
     );
 }
+
+/// The heading at which 12 m/s meets a 1 rad/s wave at zero encounter frequency, acos(1 / (k U)), deg.
+const ZERO_ENCOUNTER_HEADING_DEG: f64 = 35.2;
+/// That figure is quoted to 0.1 deg: a margin of one unit in its last digit (the turn sweeps 40 to 30 deg).
+const HEADING_TOL_DEG: f64 = 0.1;
 
 #[test]
 fn a_component_whose_encounter_frequency_passes_through_zero_in_a_turn_is_counted() {
@@ -87,7 +95,7 @@ fn a_component_whose_encounter_frequency_passes_through_zero_in_a_turn_is_counte
     // turning to port at 0.1 deg/s for 100 s takes it from 40 to 30 deg
     let k = wave_number(1.0, model.g_m_s2, model.water_depth_m);
     let beta0 = (1.0 / (k * 12.0)).acos().to_degrees();
-    assert!((beta0 - 35.2).abs() < 0.1, "{beta0}");
+    assert!((beta0 - ZERO_ENCOUNTER_HEADING_DEG).abs() < HEADING_TOL_DEG, "{beta0}");
     let track = Track {
         turn_rate_rad_s: 0.1f64.to_radians(),
         ..Track::straight(12.0)
@@ -212,6 +220,9 @@ fn disc_field() -> WaveField {
     }
 }
 
+/// The horizon tends to the stationary one as the speed goes to 0: at +-1 mm/s within this, s (a margin).
+const CREEP_HORIZON_TOL_S: f64 = 0.05;
+
 #[test]
 fn a_vessel_moving_into_the_observed_disc_has_a_longer_horizon_than_one_moving_out() {
     let f = disc_field();
@@ -224,7 +235,7 @@ fn a_vessel_moving_into_the_observed_disc_has_a_longer_horizon_than_one_moving_o
     // both reduce to the stationary horizon as the speed goes to zero
     for v in [1e-3, -1e-3] {
         let h = horizon::of_field(&f, at, [v, 0.0], 0.0).horizon_s;
-        assert!((h - still).abs() < 0.05, "{h} against {still}");
+        assert!((h - still).abs() < CREEP_HORIZON_TOL_S, "{h} against {still}");
     }
 }
 
@@ -263,6 +274,8 @@ fn value_at(h: &ForecastHeader, v: &[f64], series: usize, t_s: f64) -> Option<f6
 /// forecasts and horizons as without navigation. Heave within this of the motion's own scale (the
 /// fitted pose carries the mean of the yaw and sway oscillation), m.
 const SAME_POSE_HEAVE_M: f64 = 0.01;
+/// ... and horizons within this, s: the same pose should change nothing; a margin for the fitted pose's mean.
+const SAME_POSE_HORIZON_S: f64 = 1.0;
 
 #[test]
 fn navigation_at_the_site_s_pose_forecasts_as_the_site_does() {
@@ -295,7 +308,7 @@ fn navigation_at_the_site_s_pose_forecasts_as_the_site_does() {
         }
     }
     eprintln!("navigation at the site's pose: horizons differ by {worst_h:.3} s, heave by {worst_x:.4} m");
-    assert!(worst_h < 1.0, "{worst_h}");
+    assert!(worst_h < SAME_POSE_HORIZON_S, "{worst_h}");
     assert!(worst_x < SAME_POSE_HEAVE_M, "{worst_x}");
 }
 
@@ -303,6 +316,8 @@ fn navigation_at_the_site_s_pose_forecasts_as_the_site_does() {
 
 /// Simulated seconds: the turn starts at 300 s (the issue's), and lasts the rest.
 const DEMO_S: f64 = 720.0;
+/// Forecasts per simulated second, at least: the demo issues one a second, the rest a margin for the start.
+const MIN_FORECASTS_PER_S: f64 = 0.9;
 /// The issue's bar: heave and roll correlation at 30 s lead, each vessel.
 const CORRELATION_30S: f64 = 0.9;
 const LEAD_S: f64 = 30.0;
@@ -370,7 +385,7 @@ fn correlation(
 fn the_two_ship_demo_underway_and_turning_is_forecast_from_its_navigation() {
     let log = demo_log();
     let fs = replayed(log, &log.records);
-    assert!(fs.len() as f64 > 0.9 * DEMO_S, "{} forecasts", fs.len());
+    assert!(fs.len() as f64 > MIN_FORECASTS_PER_S * DEMO_S, "{} forecasts", fs.len());
     assert!(fs.iter().all(|(h, _)| h.flags & flags::NAVIGATION_FALLBACK == 0));
     for (v, name) in [(0, "carrier"), (1, "lighter")] {
         for (d, dof) in [(2, "heave"), (3, "roll")] {
@@ -475,6 +490,11 @@ fn scan_field(masked: impl Fn(f64, f64) -> bool) -> WaveField {
     f
 }
 
+/// The radius of the blind zone the test masks out of the scans, m.
+const BLIND_RADIUS_M: f64 = 200.0;
+/// A cell of the scans' map, m (2 km over 128 cells): the blind zone's edge is found to within one.
+const SCAN_CELL_M: f64 = 2000.0 / 128.0;
+
 /// A radar's blind zone (200 m around the antenna) is not inside the scans' region, to a cell (the
 /// map's 15.6 m): the waves crossing it are known from where they were seen; a map without one has
 /// none.
@@ -485,9 +505,14 @@ fn a_blind_zone_is_not_inside_the_scans_region() {
         _ => unreachable!(),
     };
     assert_eq!(inner(scan_field(|_, _| false)), 0.0);
-    let blind = inner(scan_field(|x, y| x.hypot(y) < 200.0));
-    assert!((blind - 200.0).abs() < 2000.0 / 128.0, "{blind}");
+    let blind = inner(scan_field(|x, y| x.hypot(y) < BLIND_RADIUS_M));
+    assert!((blind - BLIND_RADIUS_M).abs() < SCAN_CELL_M, "{blind}");
 }
+
+/// Masking the up-wave side leaves at most this fraction of the horizon: the waves from there go unseen.
+const MASKED_UPWAVE_MAX_FRACTION: f64 = 0.5;
+/// Masking the down-wave side changes the horizon by less than this fraction of it (a margin: it changes little).
+const MASKED_DOWNWAVE_TOL: f64 = 0.1;
 
 /// A sector the superstructure masks on the side the waves come from (west: they travel east) halves
 /// the reach there; on the side they go to it changes little.
@@ -498,8 +523,11 @@ fn a_masked_sector_shortens_the_horizon_for_waves_from_that_side() {
     let west = scan_horizon(|x, y| x < 0.0 && y.abs() < -x && x.hypot(y) > 150.0);
     let east = scan_horizon(|x, y| x > 0.0 && y.abs() < x && x.hypot(y) > 150.0);
     eprintln!("scan horizons: whole disc {full:.1} s, west (up-wave) masked {west:.1} s, east masked {east:.1} s");
-    assert!(west < 0.5 * full, "{west} against {full}");
-    assert!((east - full).abs() < 0.1 * full, "{east} against {full}");
+    assert!(west < MASKED_UPWAVE_MAX_FRACTION * full, "{west} against {full}");
+    assert!(
+        (east - full).abs() < MASKED_DOWNWAVE_TOL * full,
+        "{east} against {full}"
+    );
 }
 
 /// The same sea as radar scans (`simulate.radar.output = "grid"`, inverted by the daemon) and as the

@@ -153,7 +153,7 @@ pub fn view(
         duration_s: cfg.operation.duration_s,
         history_s: cfg.console.history_s,
         period_s: cfg.forecast.period_s,
-        history_wanted_s: shipcast::service::history_wanted_s(cfg, sys),
+        history_wanted_s: shipcast::engine::history_wanted_s(cfg, sys),
         confidence: cfg.operation.confidence,
         colours,
     };

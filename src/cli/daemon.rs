@@ -2,12 +2,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use shipcast::engine::vessel_positions;
 use shipcast::files;
-use shipcast::hydro::Dof;
+use shipcast::hydro::{Dof, VesselSystem};
 use shipcast::ipc::wire::{Status, flags};
 use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
 use shipcast::service::config::{self, ShipcastConfig};
-use shipcast::service::{self, to_wire, vessel_positions};
+use shipcast::service::{self, to_wire};
 use shipcast::sim::{ImuSpec, RadarSpec, SimSpec, Simulation};
 use shipcast::waves::field::heading_from_compass_deg;
 use shipcast::waves::sea::{SeaState, Spreading};
@@ -90,8 +91,11 @@ pub fn run(cfg: ShipcastConfig) -> Result<()> {
         .enable_all()
         .build()?;
     let stop = Arc::new(AtomicBool::new(false));
-    rt.block_on(service::run(cfg, sys, stop))
-        .map_err(|e| anyhow::anyhow!("{e}"))
+    rt.block_on(async {
+        let shutdown = service::shutdown_signals()?;
+        service::run(cfg, sys, stop, shutdown).await
+    })
+    .map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 fn sim_spec(cfg: &ShipcastConfig, duration_s: f64) -> SimSpec {
@@ -174,68 +178,15 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     let mut sim = Simulation::new(
         &sys,
         truth.as_ref(),
-        service::rom_options(&cfg, &sys),
+        shipcast::engine::rom_options(&cfg, &sys),
         sim_spec(&cfg, duration),
     )
     .context("computing the true motion")?;
     tracing::info!(seconds = t.elapsed().as_secs_f64(), "true motion computed");
-    let n_bodies = sim.n_bodies;
-    let names: Vec<String> = sys
-        .spec
-        .bodies
-        .iter()
-        .flat_map(|b| Dof::ALL.map(|d| format!("{}.{}", b.name, d.output_name())))
-        .collect();
-    let publisher = if a.publish {
-        Some(
-            SensorPublisher::new(&Names {
-                prefix: cfg.ipc.service_prefix.clone(),
-            })
-            .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?,
-        )
-    } else {
-        None
-    };
-    let mut elsewhere: Vec<(u32, SensorPublisher)> = vec![];
-    for vp in &a.vessel_prefix {
-        let (v, prefix) = vp
-            .split_once('=')
-            .and_then(|(v, p)| Some((v.trim().parse::<u32>().ok()?, p.trim())))
-            .filter(|(v, p)| (*v as usize) < n_bodies && !p.is_empty())
-            .ok_or_else(|| anyhow::anyhow!("--vessel-prefix {vp:?}: VESSEL=PREFIX, a vessel 0..{n_bodies}"))?;
-        let p = SensorPublisher::new(&Names { prefix: prefix.into() })
-            .map_err(|e| anyhow::anyhow!("iceoryx2 (--vessel-prefix {vp}): {e}"))?;
-        elsewhere.push((v, p));
-    }
-    let publisher_of = |vessel: u32| -> Option<&SensorPublisher> {
-        elsewhere
-            .iter()
-            .find(|(v, _)| *v == vessel)
-            .map(|(_, p)| p)
-            .or(publisher.as_ref())
-    };
+    let mut out = SimOutputs::open(a, &cfg, &sys, sim.n_bodies)?;
     // the data clock: UNIX seconds at the start (simulate.start_unix_s, default the wall clock), then
     // simulation time; published and recorded stamps and log times are on it
     let epoch = cfg.simulate.start_unix_s.unwrap_or_else(service::wall_s);
-    let mut truth_out = match &a.truth {
-        Some(p) => {
-            let mut f =
-                std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?);
-            writeln!(f, "t_s,{}", names.join(","))?;
-            Some(f)
-        }
-        None => None,
-    };
-    let mut recorder = match &a.record {
-        Some(p) => Some(
-            shipcast::record::Recorder::create(
-                p,
-                &shipcast::record::LogInfo::of(&cfg, &cfg.system.file, &sys, "simulate"),
-            )
-            .map_err(|e| anyhow::anyhow!("{e}"))?,
-        ),
-        None => None,
-    };
     let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
     let radar_dt = cfg.simulate.radar.period_s;
     let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
@@ -253,31 +204,21 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         let stop = stop.clone();
         let _ = ctrlc_flag(stop);
     }
+    let wait_until = |t: f64| {
+        let due = Duration::from_secs_f64(t / speed);
+        if let Some(wait) = due.checked_sub(start.elapsed()) {
+            std::thread::sleep(wait);
+        }
+    };
     while next_imu <= duration && !stop_seen {
         let t = next_imu.min(next_radar).min(next_nav);
         if next_nav <= next_imu && next_nav <= next_radar {
-            for fix in sim.navigation(t) {
-                let n = shipcast::service::navigation::to_wire(fix.vessel as u32, t + epoch, &fix);
-                if let Some(p) = publisher_of(n.vessel) {
-                    let due = Duration::from_secs_f64(t / speed);
-                    if let Some(wait) = due.checked_sub(start.elapsed()) {
-                        std::thread::sleep(wait);
-                    }
-                    p.navigation(&n)
-                        .map_err(|e| anyhow::anyhow!("publishing navigation: {e}"))?;
-                } else if let Some(rec) = recorder.as_mut() {
-                    rec.write("/navigation", t + epoch, &shipcast::record::NavigationRecord::of(&n))
-                        .map_err(|e| anyhow::anyhow!("{e}"))?;
-                }
-            }
+            out.navigation(&mut sim, t, epoch, &wait_until)?;
             next_nav += nav_dt;
             continue;
         }
-        if let Some(p) = &publisher {
-            let due = Duration::from_secs_f64(t / speed);
-            if let Some(wait) = due.checked_sub(start.elapsed()) {
-                std::thread::sleep(wait);
-            }
+        if let Some(p) = &out.publisher {
+            wait_until(t);
             if next_radar <= next_imu {
                 let field = sim.radar(t);
                 if grid_output {
@@ -295,12 +236,12 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
             for mut s in sim.imu(t) {
                 s.time_s += epoch;
                 let m = to_wire(&s);
-                publisher_of(m.vessel)
+                out.publisher_of(m.vessel)
                     .unwrap_or(p)
                     .motion(&m)
                     .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
             }
-        } else if let Some(rec) = recorder.as_mut() {
+        } else if let Some(rec) = out.recorder.as_mut() {
             let radar = next_radar <= next_imu;
             let at = a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
             record_step(rec, &mut sim, t, epoch, radar, (grid_every, &mut scans), grid_output)
@@ -313,27 +254,131 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
             next_radar += radar_dt;
             continue;
         }
-        if let Some(f) = truth_out.as_mut() {
+        out.truth(&sim, t, epoch)?;
+        next_imu += imu_dt;
+        stop_seen = stop.load(std::sync::atomic::Ordering::Relaxed);
+    }
+    out.finish(duration, t)
+}
+
+/// Where `simulate` sends what it makes: iceoryx2 publishers (one per `--vessel-prefix`, the default
+/// one), a log, the true motion's CSV.
+struct SimOutputs {
+    publisher: Option<SensorPublisher>,
+    elsewhere: Vec<(u32, SensorPublisher)>,
+    recorder: Option<shipcast::record::Recorder<std::io::BufWriter<std::fs::File>>>,
+    truth_out: Option<std::io::BufWriter<std::fs::File>>,
+    n_bodies: usize,
+}
+
+impl SimOutputs {
+    fn open(a: &SimulateArgs, cfg: &ShipcastConfig, sys: &VesselSystem, n_bodies: usize) -> Result<SimOutputs> {
+        let publisher = if a.publish {
+            Some(
+                SensorPublisher::new(&Names {
+                    prefix: cfg.ipc.service_prefix.clone(),
+                })
+                .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?,
+            )
+        } else {
+            None
+        };
+        let mut elsewhere: Vec<(u32, SensorPublisher)> = vec![];
+        for vp in &a.vessel_prefix {
+            let (v, prefix) = vp
+                .split_once('=')
+                .and_then(|(v, p)| Some((v.trim().parse::<u32>().ok()?, p.trim())))
+                .filter(|(v, p)| (*v as usize) < n_bodies && !p.is_empty())
+                .ok_or_else(|| anyhow::anyhow!("--vessel-prefix {vp:?}: VESSEL=PREFIX, a vessel 0..{n_bodies}"))?;
+            let p = SensorPublisher::new(&Names { prefix: prefix.into() })
+                .map_err(|e| anyhow::anyhow!("iceoryx2 (--vessel-prefix {vp}): {e}"))?;
+            elsewhere.push((v, p));
+        }
+        let names: Vec<String> = sys
+            .spec
+            .bodies
+            .iter()
+            .flat_map(|b| Dof::ALL.map(|d| format!("{}.{}", b.name, d.output_name())))
+            .collect();
+        let truth_out = match &a.truth {
+            Some(p) => {
+                let mut f = std::io::BufWriter::new(
+                    std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?,
+                );
+                writeln!(f, "t_s,{}", names.join(","))?;
+                Some(f)
+            }
+            None => None,
+        };
+        let recorder = match &a.record {
+            Some(p) => Some(
+                shipcast::record::Recorder::create(
+                    p,
+                    &shipcast::record::LogInfo::of(cfg, &cfg.system.file, sys, "simulate"),
+                )
+                .map_err(|e| anyhow::anyhow!("{e}"))?,
+            ),
+            None => None,
+        };
+        Ok(SimOutputs {
+            publisher,
+            elsewhere,
+            recorder,
+            truth_out,
+            n_bodies,
+        })
+    }
+
+    /// The publisher of a vessel's sensors: its `--vessel-prefix`'s, else the default one.
+    fn publisher_of(&self, vessel: u32) -> Option<&SensorPublisher> {
+        self.elsewhere
+            .iter()
+            .find(|(v, _)| *v == vessel)
+            .map(|(_, p)| p)
+            .or(self.publisher.as_ref())
+    }
+
+    /// The navigation fixes at `t`: published (at their time, `wait_until`) or recorded.
+    fn navigation(&mut self, sim: &mut Simulation, t: f64, epoch: f64, wait_until: &impl Fn(f64)) -> Result<()> {
+        for fix in sim.navigation(t) {
+            let n = shipcast::engine::navigation::to_wire(fix.vessel as u32, t + epoch, &fix);
+            if let Some(p) = self.publisher_of(n.vessel) {
+                wait_until(t);
+                p.navigation(&n)
+                    .map_err(|e| anyhow::anyhow!("publishing navigation: {e}"))?;
+            } else if let Some(rec) = self.recorder.as_mut() {
+                rec.write("/navigation", t + epoch, &shipcast::record::NavigationRecord::of(&n))
+                    .map_err(|e| anyhow::anyhow!("{e}"))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The true motion at `t` into the CSV, if asked for.
+    fn truth(&mut self, sim: &Simulation, t: f64, epoch: f64) -> Result<()> {
+        if let Some(f) = self.truth_out.as_mut() {
             write!(f, "{:.3}", t + epoch)?;
-            for i in 0..6 * n_bodies {
+            for i in 0..6 * self.n_bodies {
                 write!(f, ",{:.6e}", Dof::of_index(i).to_output(sim.true_x(t, i)))?;
             }
             writeln!(f)?;
         }
-        next_imu += imu_dt;
-        stop_seen = stop.load(std::sync::atomic::Ordering::Relaxed);
+        Ok(())
     }
-    if let Some(mut f) = truth_out {
-        f.flush()?;
+
+    fn finish(self, duration: f64, t: Instant) -> Result<()> {
+        if let Some(mut f) = self.truth_out {
+            f.flush()?;
+        }
+        if let Some(rec) = self.recorder {
+            rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
+            eprintln!(
+                "shipcast simulate: {duration} s recorded in {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        Ok(())
     }
-    if let Some(rec) = recorder {
-        rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
-        eprintln!(
-            "shipcast simulate: {duration} s recorded in {:.1} s",
-            t.elapsed().as_secs_f64()
-        );
-    }
-    Ok(())
 }
 
 /// Records the simulator's output at `t` (log time `t + epoch`): with `radar`, a scan's field and, every
@@ -719,7 +764,7 @@ fn plain_demo(
     stop: &AtomicBool,
 ) -> Result<()> {
     use shipcast::ipc::MotionSubscriber;
-    let wanted_s = shipcast::service::history_wanted_s(cfg, sys);
+    let wanted_s = shipcast::engine::history_wanted_s(cfg, sys);
     let mut first_motion_s: Option<f64> = None;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),

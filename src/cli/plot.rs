@@ -8,6 +8,7 @@
 
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::register_font;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -231,116 +232,140 @@ impl Figure for ForecastFigure<'_> {
                 .light_line_style(RGBColor(238, 238, 238))
                 .bold_line_style(RGBColor(215, 215, 215))
                 .draw()?;
-            let truth = Stroke {
-                colour: TRUTH,
-                width: 2,
-                dashed: false,
-            };
-            let fc = Stroke {
-                colour: FORECAST,
-                width: 2,
-                dashed: false,
-            };
-            let fc_past = Stroke {
-                colour: FORECAST,
-                width: 2,
-                dashed: true,
-            };
-            let lim = Stroke {
-                colour: LIMIT,
-                width: 1,
-                dashed: false,
-            };
-            let hz = Stroke {
-                colour: HORIZON,
-                width: 1,
-                dashed: true,
-            };
-            // labels at the left end of the limits, and beside the horizon on the side with room
-            for l in [p.limit, -p.limit] {
-                line(&mut chart, &[(0.0, l), (span, l)], lim)?;
-                let below = l < 0.0;
-                chart.draw_series(std::iter::once(
-                    EmptyElement::at((0.0, l))
-                        + Text::new(
-                            format!("limit {}{} {}", if below { "−" } else { "+" }, p.limit, p.unit),
-                            (6, if below { 4 } else { -4 }),
-                            style(13)
-                                .color(&LIMIT)
-                                .pos(Pos::new(HPos::Left, if below { VPos::Top } else { VPos::Bottom })),
-                        ),
-                ))?;
-            }
-            // the band, shaded under everything else
-            if !p.band.is_empty() {
-                let outline: Vec<(f64, f64)> = p
-                    .band
-                    .iter()
-                    .map(|b| (b.0, b.2))
-                    .chain(p.band.iter().rev().map(|b| (b.0, b.1)))
-                    .filter(|q| q.1.is_finite())
-                    .collect();
-                chart.draw_series(std::iter::once(Polygon::new(outline, FORECAST.mix(0.18).filled())))?;
-            }
-            let t_h = p.trusted_s.clamp(0.0, span);
-            let t_f = p.trusted_from_s.clamp(0.0, t_h);
-            line(&mut chart, &[(t_h, -peak), (t_h, peak)], hz)?;
-            if t_f > 0.0 {
-                line(&mut chart, &[(t_f, -peak), (t_f, peak)], hz)?;
-                chart.draw_series(std::iter::once(
-                    EmptyElement::at((t_f, -peak))
-                        + Text::new(
-                            format!("trusted from {t_f:.0} s"),
-                            (5, -4),
-                            style(13).color(&HORIZON).pos(Pos::new(HPos::Left, VPos::Bottom)),
-                        ),
-                ))?;
-            }
-            let left = t_h > 0.6 * span;
-            chart.draw_series(std::iter::once(
-                EmptyElement::at((t_h, peak))
-                    + Text::new(
-                        format!("trusted horizon {t_h:.0} s"),
-                        (if left { -5 } else { 5 }, 4),
-                        style(13)
-                            .color(&HORIZON)
-                            .pos(Pos::new(if left { HPos::Right } else { HPos::Left }, VPos::Top)),
-                    ),
-            ))?;
-            line(&mut chart, &p.actual, truth)?;
-            // solid over the trusted span, dashed before and after it (joined at its ends)
-            let early: Vec<(f64, f64)> = p.forecast.iter().copied().filter(|q| q.0 <= t_f).collect();
-            let before: Vec<(f64, f64)> = p
-                .forecast
-                .iter()
-                .copied()
-                .filter(|q| q.0 >= t_f && q.0 <= t_h)
-                .collect();
-            let after: Vec<(f64, f64)> = match before.last() {
-                Some(&b) => std::iter::once(b)
-                    .chain(p.forecast.iter().copied().filter(|q| q.0 > t_h))
-                    .collect(),
-                None => p.forecast.clone(),
-            };
-            if t_f > 0.0 {
-                line(&mut chart, &early, fc_past)?;
-            }
-            line(&mut chart, &before, fc)?;
-            line(&mut chart, &after, fc_past)?;
+            let (t_f, t_h) = panel_marks(&mut chart, p, span, peak)?;
+            forecast_lines(&mut chart, p, t_f, t_h)?;
             legend(
                 &side,
                 64,
                 &[
-                    (format!("{} motion", self.reference), truth),
-                    ("forecast (trusted)".into(), fc),
-                    ("forecast outside the span".into(), fc_past),
-                    (format!("limits ±{} {}", p.limit, p.unit), lim),
-                    (format!("trusted horizon {t_h:.0} s"), hz),
+                    (format!("{} motion", self.reference), TRUTH_STROKE),
+                    ("forecast (trusted)".into(), FORECAST_STROKE),
+                    ("forecast outside the span".into(), FORECAST_PAST_STROKE),
+                    (format!("limits ±{} {}", p.limit, p.unit), LIMIT_STROKE),
+                    (format!("trusted horizon {t_h:.0} s"), HORIZON_STROKE),
                 ],
             )?;
         }
         Ok(())
     }
+}
+
+const TRUTH_STROKE: Stroke = Stroke {
+    colour: TRUTH,
+    width: 2,
+    dashed: false,
+};
+const FORECAST_STROKE: Stroke = Stroke {
+    colour: FORECAST,
+    width: 2,
+    dashed: false,
+};
+const FORECAST_PAST_STROKE: Stroke = Stroke {
+    colour: FORECAST,
+    width: 2,
+    dashed: true,
+};
+const LIMIT_STROKE: Stroke = Stroke {
+    colour: LIMIT,
+    width: 1,
+    dashed: false,
+};
+const HORIZON_STROKE: Stroke = Stroke {
+    colour: HORIZON,
+    width: 1,
+    dashed: true,
+};
+
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A panel's limits (labelled at their left end), its band (shaded under everything else) and the
+/// trusted span's ends (labelled on the side with room); the span's start and end, s.
+fn panel_marks<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    p: &ForecastPanel,
+    span: f64,
+    peak: f64,
+) -> Result<(f64, f64), DrawingAreaErrorKind<DB::ErrorType>> {
+    for l in [p.limit, -p.limit] {
+        line(chart, &[(0.0, l), (span, l)], LIMIT_STROKE)?;
+        let below = l < 0.0;
+        chart.draw_series(std::iter::once(
+            EmptyElement::at((0.0, l))
+                + Text::new(
+                    format!("limit {}{} {}", if below { "−" } else { "+" }, p.limit, p.unit),
+                    (6, if below { 4 } else { -4 }),
+                    style(13)
+                        .color(&LIMIT)
+                        .pos(Pos::new(HPos::Left, if below { VPos::Top } else { VPos::Bottom })),
+                ),
+        ))?;
+    }
+    if !p.band.is_empty() {
+        let outline: Vec<(f64, f64)> = p
+            .band
+            .iter()
+            .map(|b| (b.0, b.2))
+            .chain(p.band.iter().rev().map(|b| (b.0, b.1)))
+            .filter(|q| q.1.is_finite())
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(outline, FORECAST.mix(0.18).filled())))?;
+    }
+    let t_h = p.trusted_s.clamp(0.0, span);
+    let t_f = p.trusted_from_s.clamp(0.0, t_h);
+    line(chart, &[(t_h, -peak), (t_h, peak)], HORIZON_STROKE)?;
+    if t_f > 0.0 {
+        line(chart, &[(t_f, -peak), (t_f, peak)], HORIZON_STROKE)?;
+        chart.draw_series(std::iter::once(
+            EmptyElement::at((t_f, -peak))
+                + Text::new(
+                    format!("trusted from {t_f:.0} s"),
+                    (5, -4),
+                    style(13).color(&HORIZON).pos(Pos::new(HPos::Left, VPos::Bottom)),
+                ),
+        ))?;
+    }
+    let left = t_h > 0.6 * span;
+    chart.draw_series(std::iter::once(
+        EmptyElement::at((t_h, peak))
+            + Text::new(
+                format!("trusted horizon {t_h:.0} s"),
+                (if left { -5 } else { 5 }, 4),
+                style(13)
+                    .color(&HORIZON)
+                    .pos(Pos::new(if left { HPos::Right } else { HPos::Left }, VPos::Top)),
+            ),
+    ))?;
+    Ok((t_f, t_h))
+}
+
+/// The motion that followed, and the forecast: solid over the trusted span `t_f..t_h`, dashed before
+/// and after it (joined at its ends).
+fn forecast_lines<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    p: &ForecastPanel,
+    t_f: f64,
+    t_h: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    line(chart, &p.actual, TRUTH_STROKE)?;
+    let early: Vec<(f64, f64)> = p.forecast.iter().copied().filter(|q| q.0 <= t_f).collect();
+    let before: Vec<(f64, f64)> = p
+        .forecast
+        .iter()
+        .copied()
+        .filter(|q| q.0 >= t_f && q.0 <= t_h)
+        .collect();
+    let after: Vec<(f64, f64)> = match before.last() {
+        Some(&b) => std::iter::once(b)
+            .chain(p.forecast.iter().copied().filter(|q| q.0 > t_h))
+            .collect(),
+        None => p.forecast.clone(),
+    };
+    if t_f > 0.0 {
+        line(chart, &early, FORECAST_PAST_STROKE)?;
+    }
+    line(chart, &before, FORECAST_STROKE)?;
+    line(chart, &after, FORECAST_PAST_STROKE)?;
+    Ok(())
 }
 
 /// Writes one forecast against the motion that followed (`reference`: `truth` or `measured`),

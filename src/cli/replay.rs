@@ -657,7 +657,7 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         eprintln!("{}: {} motion samples", p.display(), m.len());
         records.extend(m.into_iter().map(|r| (r.time_s, Record::Motion(r))));
     }
-    let (vessels_m, _) = shipcast::service::vessel_positions(&cfg, &sys);
+    let (vessels_m, _) = shipcast::engine::vessel_positions(&cfg, &sys);
     for p in &a.probe {
         let file = p.display().to_string();
         let rec = probe_csv(&read(p)?, &file).map_err(|e| anyhow::anyhow!(e))?;

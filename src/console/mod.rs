@@ -66,7 +66,7 @@ pub struct Settings {
     pub history_s: f64,
     /// The daemon's forecast period (its config), for staleness.
     pub period_s: f64,
-    /// The measured history the daemon's forecasts want behind them, s ([`crate::service::history_wanted_s`]):
+    /// The measured history the daemon's forecasts want behind them, s ([`crate::engine::history_wanted_s`]):
     /// how long the console says the warm-up lasts.
     pub history_wanted_s: f64,
     /// The confidence of a go (`operation.confidence`): the band drawn holds this probability.

@@ -357,7 +357,7 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     let beyond = pts(k_h.saturating_sub(1)..fc.len());
     // the band holding the go's confidence: forecast +- z sigma
     let sigma = c.forecast_sigma(ch);
-    let z = crate::rom::spread::band_z(c.settings.confidence);
+    let z = crate::band::band_z(c.settings.confidence);
     let band = |sign: f64| -> Vec<(f64, f64)> {
         (0..fc.len().min(sigma.len()))
             .filter(|k| fc[*k].is_finite() && sigma[*k].is_finite())

@@ -253,71 +253,9 @@ impl SystemSpec {
         if raw.wamit.trim().is_empty() {
             return Err(key("wamit", "must name the stem of the WAMIT files".into()));
         }
-        let mut speed_databases: Vec<(f64, String)> = vec![];
-        for (i, d) in raw.database.iter().enumerate() {
-            let at = format!("database[{i}]");
-            if !(d.speed_m_s.is_finite() && d.speed_m_s >= 0.0 && d.speed_m_s <= MAX_DATABASE_SPEED_M_S) {
-                return Err(key(
-                    &format!("{at}.speed_m_s"),
-                    format!("must be in [0, {MAX_DATABASE_SPEED_M_S}] m/s, found {}", d.speed_m_s),
-                ));
-            }
-            if d.wamit.trim().is_empty() {
-                return Err(key(
-                    &format!("{at}.wamit"),
-                    "must name the stem of the WAMIT files".into(),
-                ));
-            }
-            if d.speed_m_s == 0.0 {
-                if d.wamit != raw.wamit {
-                    return Err(key(
-                        &format!("{at}.wamit"),
-                        format!(
-                            "the database at speed 0 is `wamit` (\"{}\"), found \"{}\"",
-                            raw.wamit, d.wamit
-                        ),
-                    ));
-                }
-                continue;
-            }
-            if speed_databases.last().is_some_and(|(u, _)| *u >= d.speed_m_s) {
-                return Err(key(
-                    &format!("{at}.speed_m_s"),
-                    "the databases' speeds must be listed in increasing order, each once".into(),
-                ));
-            }
-            speed_databases.push((d.speed_m_s, d.wamit.clone()));
-        }
-        let water_depth_m = match raw.water_depth {
-            DepthSpec::Word(w) if w == "infinite" => None,
-            DepthSpec::Word(w) => {
-                return Err(key(
-                    "water_depth",
-                    format!("expected \"infinite\" or metres, found \"{w}\""),
-                ));
-            }
-            DepthSpec::Metres(d) if d.is_finite() && d > 0.0 => Some(d),
-            DepthSpec::Metres(d) => return Err(key("water_depth", format!("must be positive, found {d}"))),
-        };
-        let mut irf = IrfOptions::default();
-        if let Some(f) = raw.irf {
-            if let Some(dt) = f.dt_s {
-                super::radiation::check_dt(dt).map_err(|e| key("irf.dt_s", e.to_string()))?;
-                irf.dt_s = dt;
-            }
-            if let Some(d) = f.duration_s {
-                if !(1.0..=3600.0).contains(&d) {
-                    return Err(key("irf.duration_s", format!("must be in [1, 3600] s, found {d}")));
-                }
-                irf.duration_s = Some(d);
-            }
-            if let Some(p) = f.passivity {
-                irf.passivity = p;
-            }
-            if let Some(t) = f.tail {
-                irf.tail = t;
-            }
-        }
+        let speed_databases = speed_databases(&raw).map_err(|(k, msg)| key(&k, msg))?;
+        let water_depth_m = water_depth(&raw.water_depth).map_err(|msg| key("water_depth", msg))?;
+        let irf = irf_options(raw.irf.as_ref()).map_err(|(k, msg)| key(k, msg))?;
         if raw.body.is_empty() {
             return Err(key("body", "at least one [[body]] is needed".into()));
         }
@@ -331,23 +269,8 @@ impl SystemSpec {
             bodies.push(body);
         }
         let n = 6 * bodies.len();
-        let extra = |name: &str, entries: &[[f64; 3]]| -> Result<DMatrix<f64>> {
-            let mut m = DMatrix::zeros(n, n);
-            for (e, [i, j, v]) in entries.iter().enumerate() {
-                for idx in [i, j] {
-                    if idx.fract() != 0.0 || *idx < 1.0 || *idx > n as f64 {
-                        return Err(key(
-                            &format!("{name}[{e}]"),
-                            format!("mode {idx} is outside 1..{n} (WAMIT mode numbers of {} bodies)", n / 6),
-                        ));
-                    }
-                }
-                if !v.is_finite() {
-                    return Err(key(&format!("{name}[{e}]"), format!("value {v} is not finite")));
-                }
-                m[(*i as usize - 1, *j as usize - 1)] += v;
-            }
-            Ok(m)
+        let extra = |name: &str, entries: &[[f64; 3]]| {
+            extra_entries(entries, n).map_err(|(e, msg)| key(&format!("{name}[{e}]"), msg))
         };
         let extra_damping = extra("linear_damping_entries", &raw.linear_damping_entries)?;
         let extra_stiffness = extra("linear_stiffness_entries", &raw.linear_stiffness_entries)?;
@@ -380,6 +303,99 @@ impl SystemSpec {
             external,
         })
     }
+}
+
+/// The databases at forward speed of a system file (speed 0 is `wamit` itself), in increasing order;
+/// an error is (key, message).
+fn speed_databases(raw: &SystemFile) -> std::result::Result<Vec<(f64, String)>, (String, String)> {
+    let mut speed_databases: Vec<(f64, String)> = vec![];
+    for (i, d) in raw.database.iter().enumerate() {
+        let at = format!("database[{i}]");
+        if !(d.speed_m_s.is_finite() && d.speed_m_s >= 0.0 && d.speed_m_s <= MAX_DATABASE_SPEED_M_S) {
+            return Err((
+                format!("{at}.speed_m_s"),
+                format!("must be in [0, {MAX_DATABASE_SPEED_M_S}] m/s, found {}", d.speed_m_s),
+            ));
+        }
+        if d.wamit.trim().is_empty() {
+            return Err((format!("{at}.wamit"), "must name the stem of the WAMIT files".into()));
+        }
+        if d.speed_m_s == 0.0 {
+            if d.wamit != raw.wamit {
+                return Err((
+                    format!("{at}.wamit"),
+                    format!(
+                        "the database at speed 0 is `wamit` (\"{}\"), found \"{}\"",
+                        raw.wamit, d.wamit
+                    ),
+                ));
+            }
+            continue;
+        }
+        if speed_databases.last().is_some_and(|(u, _)| *u >= d.speed_m_s) {
+            return Err((
+                format!("{at}.speed_m_s"),
+                "the databases' speeds must be listed in increasing order, each once".into(),
+            ));
+        }
+        speed_databases.push((d.speed_m_s, d.wamit.clone()));
+    }
+    Ok(speed_databases)
+}
+
+/// `water_depth`: "infinite" (None) or positive metres.
+fn water_depth(spec: &DepthSpec) -> std::result::Result<Option<f64>, String> {
+    Ok(match spec {
+        DepthSpec::Word(w) if w == "infinite" => None,
+        DepthSpec::Word(w) => return Err(format!("expected \"infinite\" or metres, found \"{w}\"")),
+        DepthSpec::Metres(d) if d.is_finite() && *d > 0.0 => Some(*d),
+        DepthSpec::Metres(d) => return Err(format!("must be positive, found {d}")),
+    })
+}
+
+/// The `[irf]` table over the defaults; an error is (key, message).
+fn irf_options(f: Option<&IrfFile>) -> std::result::Result<IrfOptions, (&'static str, String)> {
+    let mut irf = IrfOptions::default();
+    if let Some(f) = f {
+        if let Some(dt) = f.dt_s {
+            super::radiation::check_dt(dt).map_err(|e| ("irf.dt_s", e.to_string()))?;
+            irf.dt_s = dt;
+        }
+        if let Some(d) = f.duration_s {
+            if !(1.0..=3600.0).contains(&d) {
+                return Err(("irf.duration_s", format!("must be in [1, 3600] s, found {d}")));
+            }
+            irf.duration_s = Some(d);
+        }
+        if let Some(p) = f.passivity {
+            irf.passivity = p;
+        }
+        if let Some(t) = f.tail {
+            irf.tail = t;
+        }
+    }
+    Ok(irf)
+}
+
+/// An `n` x `n` matrix of `[i, j, value]` entries (WAMIT mode numbers 1..n, summed); an error is (the
+/// entry's index, message).
+fn extra_entries(entries: &[[f64; 3]], n: usize) -> std::result::Result<DMatrix<f64>, (usize, String)> {
+    let mut m = DMatrix::zeros(n, n);
+    for (e, [i, j, v]) in entries.iter().enumerate() {
+        for idx in [i, j] {
+            if idx.fract() != 0.0 || *idx < 1.0 || *idx > n as f64 {
+                return Err((
+                    e,
+                    format!("mode {idx} is outside 1..{n} (WAMIT mode numbers of {} bodies)", n / 6),
+                ));
+            }
+        }
+        if !v.is_finite() {
+            return Err((e, format!("value {v} is not finite")));
+        }
+        m[(*i as usize - 1, *j as usize - 1)] += v;
+    }
+    Ok(m)
 }
 
 fn line_col(text: &str, offset: usize) -> (usize, usize) {

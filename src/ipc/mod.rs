@@ -9,6 +9,8 @@
 
 pub mod wire;
 
+pub use crate::engine::message::{Input, Output, Scan};
+
 use crate::waves::field::WaveField;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
@@ -181,14 +183,6 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
     WaveField::from_flat(h.flat(ranges), rows).map_err(|e| format!("wave field: {e}"))
 }
 
-/// A radar scan decoded from the wire: the grid (its axes' coordinates from the frame's origin; NaN
-/// cells invalid) and where it lies.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Scan {
-    pub grid: crate::waves::observe::Grid,
-    pub frame: crate::waves::observe::GridFrame,
-}
-
 /// A radar scan from the wire, its header checked against its payload.
 pub fn decode_elevation(h: &ElevationHeader, payload: &[f32]) -> std::result::Result<Scan, String> {
     if h.schema_version != SCHEMA_VERSION {
@@ -257,22 +251,6 @@ pub fn encode_elevation(scan: &Scan) -> (ElevationHeader, Vec<f32>) {
     )
 }
 
-/// What the input thread forwards.
-#[derive(Debug, Clone)]
-// a wave field (its region included) a scan period: a box would be an allocation for nothing
-#[allow(clippy::large_enum_variant)]
-pub enum Input {
-    Motion(MotionSample),
-    Navigation(NavigationSample),
-    /// A radar scan (boxed: a scan is up to 4 MB).
-    Elevation(Box<Scan>),
-    Waves(WaveField),
-    /// The ship-to-ship link's health (`shipcast link`).
-    Link(LinkStatus),
-    /// A sample that could not be decoded (counted, logged).
-    Rejected(String),
-}
-
 /// Spawns the daemon's input thread. It ends when `stop` is set or the channel closes.
 pub fn spawn_input(
     names: Names,
@@ -283,41 +261,7 @@ pub fn spawn_input(
     std::thread::Builder::new()
         .name("shipcast-ipc-in".into())
         .spawn(move || {
-            let setup = || -> Result<_> {
-                let node = node()?;
-                let motion = motion_service(&node, &names)?
-                    .subscriber_builder()
-                    .buffer_size(BUFFER)
-                    .create()
-                    .map_err(err)?;
-                let waves = waves_service(&node, &names)?
-                    .subscriber_builder()
-                    .create()
-                    .map_err(err)?;
-                let nav = navigation_service(&node, &names)?
-                    .subscriber_builder()
-                    .buffer_size(BUFFER)
-                    .create()
-                    .map_err(err)?;
-                let (_, motion_l) = event(&node, &names, "motion")?;
-                let (_, waves_l) = event(&node, &names, "waves")?;
-                let (_, nav_l) = event(&node, &names, "navigation")?;
-                let elev = elevation_service(&node, &names)?
-                    .subscriber_builder()
-                    .create()
-                    .map_err(err)?;
-                let (_, elev_l) = event(&node, &names, "elevation")?;
-                let link = link_service(&node, &names)?
-                    .subscriber_builder()
-                    .create()
-                    .map_err(err)?;
-                Ok((
-                    node,
-                    (motion, nav, waves, elev, link),
-                    (motion_l, nav_l, waves_l, elev_l),
-                ))
-            };
-            let (node, (motion, nav, waves, elev, link), (motion_l, nav_l, waves_l, elev_l)) = match setup() {
+            let ports = match InputPorts::open(&names) {
                 Ok(s) => {
                     let _ = ready.send(Ok(()));
                     s
@@ -327,7 +271,6 @@ pub fn spawn_input(
                     return;
                 }
             };
-            let _ = &node;
             let ws = match waitset() {
                 Ok(w) => w,
                 Err(e) => {
@@ -336,62 +279,17 @@ pub fn spawn_input(
                 }
             };
             let (Ok(_g1), Ok(_g2), Ok(_g3), Ok(_g4), Ok(_g5)) = (
-                ws.attach_notification(&motion_l),
-                ws.attach_notification(&waves_l),
-                ws.attach_notification(&nav_l),
-                ws.attach_notification(&elev_l),
+                ws.attach_notification(&ports.motion_l),
+                ws.attach_notification(&ports.waves_l),
+                ws.attach_notification(&ports.nav_l),
+                ws.attach_notification(&ports.elev_l),
                 ws.attach_interval(STOP_CHECK),
             ) else {
                 tracing::error!("input thread: cannot attach to the waitset");
                 return;
             };
-            let drain = |motion: &Subscriber<ipc::Service, MotionSample, ()>,
-                         nav: &Subscriber<ipc::Service, NavigationSample, ()>,
-                         waves: &Subscriber<ipc::Service, [f64], WaveHeader>,
-                         elev: &Subscriber<ipc::Service, [f32], ElevationHeader>|
-             -> bool {
-                let _ = motion_l.try_wait(|_| {});
-                let _ = waves_l.try_wait(|_| {});
-                let _ = nav_l.try_wait(|_| {});
-                let _ = elev_l.try_wait(|_| {});
-                while let Ok(Some(s)) = elev.receive() {
-                    let msg = match decode_elevation(s.user_header(), s.payload()) {
-                        Ok(scan) => Input::Elevation(Box::new(scan)),
-                        Err(e) => Input::Rejected(e),
-                    };
-                    if tx.blocking_send(msg).is_err() {
-                        return false;
-                    }
-                }
-                while let Ok(Some(s)) = motion.receive() {
-                    if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
-                        return false;
-                    }
-                }
-                while let Ok(Some(s)) = nav.receive() {
-                    if tx.blocking_send(Input::Navigation(*s.payload())).is_err() {
-                        return false;
-                    }
-                }
-                while let Ok(Some(s)) = waves.receive() {
-                    let msg = match decode_waves(s.user_header(), s.payload()) {
-                        Ok(f) => Input::Waves(f),
-                        Err(e) => Input::Rejected(e),
-                    };
-                    if tx.blocking_send(msg).is_err() {
-                        return false;
-                    }
-                }
-                // the link's health comes a second at a time: read at every wake (the interval's too)
-                while let Ok(Some(s)) = link.receive() {
-                    if tx.blocking_send(Input::Link(*s.payload())).is_err() {
-                        return false;
-                    }
-                }
-                true
-            };
             // whatever was there before we attached (history of the waves service)
-            if !drain(&motion, &nav, &waves, &elev) {
+            if !ports.drain(&tx) {
                 return;
             }
             loop {
@@ -400,7 +298,7 @@ pub fn spawn_input(
                 }
                 let mut alive = true;
                 let r = ws.wait_and_process_once(|_| {
-                    alive = drain(&motion, &nav, &waves, &elev);
+                    alive = ports.drain(&tx);
                     CallbackProgression::Stop
                 });
                 if r.is_err() || !alive {
@@ -411,13 +309,105 @@ pub fn spawn_input(
         .expect("spawning the input thread")
 }
 
-/// What the output thread publishes.
-#[derive(Debug, Clone)]
-// one status a period: a box would be an allocation for nothing
-#[allow(clippy::large_enum_variant)]
-pub enum Output {
-    Forecast(ForecastHeader, Vec<f64>),
-    Status(Status),
+/// The input thread's subscribers and the listeners of their event services (the node kept alive
+/// with them).
+struct InputPorts {
+    motion: Subscriber<ipc::Service, MotionSample, ()>,
+    nav: Subscriber<ipc::Service, NavigationSample, ()>,
+    waves: Subscriber<ipc::Service, [f64], WaveHeader>,
+    elev: Subscriber<ipc::Service, [f32], ElevationHeader>,
+    link: Subscriber<ipc::Service, LinkStatus, ()>,
+    motion_l: Listener<ipc::Service>,
+    nav_l: Listener<ipc::Service>,
+    waves_l: Listener<ipc::Service>,
+    elev_l: Listener<ipc::Service>,
+    // last: dropped after the ports
+    _node: Node<ipc::Service>,
+}
+
+impl InputPorts {
+    fn open(names: &Names) -> Result<InputPorts> {
+        let node = node()?;
+        let motion = motion_service(&node, names)?
+            .subscriber_builder()
+            .buffer_size(BUFFER)
+            .create()
+            .map_err(err)?;
+        let waves = waves_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let nav = navigation_service(&node, names)?
+            .subscriber_builder()
+            .buffer_size(BUFFER)
+            .create()
+            .map_err(err)?;
+        let (_, motion_l) = event(&node, names, "motion")?;
+        let (_, waves_l) = event(&node, names, "waves")?;
+        let (_, nav_l) = event(&node, names, "navigation")?;
+        let elev = elevation_service(&node, names)?
+            .subscriber_builder()
+            .create()
+            .map_err(err)?;
+        let (_, elev_l) = event(&node, names, "elevation")?;
+        let link = link_service(&node, names)?.subscriber_builder().create().map_err(err)?;
+        Ok(InputPorts {
+            motion,
+            nav,
+            waves,
+            elev,
+            link,
+            motion_l,
+            nav_l,
+            waves_l,
+            elev_l,
+            _node: node,
+        })
+    }
+
+    /// Forwards everything received (decoded; what cannot be, as a rejection); false when the channel
+    /// has closed.
+    fn drain(&self, tx: &tokio::sync::mpsc::Sender<Input>) -> bool {
+        let _ = self.motion_l.try_wait(|_| {});
+        let _ = self.waves_l.try_wait(|_| {});
+        let _ = self.nav_l.try_wait(|_| {});
+        let _ = self.elev_l.try_wait(|_| {});
+        while let Ok(Some(s)) = self.elev.receive() {
+            let msg = match decode_elevation(s.user_header(), s.payload()) {
+                Ok(scan) => Input::Elevation(Box::new(scan)),
+                Err(e) => Input::Rejected(e),
+            };
+            if tx.blocking_send(msg).is_err() {
+                return false;
+            }
+        }
+        while let Ok(Some(s)) = self.motion.receive() {
+            if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
+                return false;
+            }
+        }
+        while let Ok(Some(s)) = self.nav.receive() {
+            if tx.blocking_send(Input::Navigation(*s.payload())).is_err() {
+                return false;
+            }
+        }
+        while let Ok(Some(s)) = self.waves.receive() {
+            let msg = match decode_waves(s.user_header(), s.payload()) {
+                Ok(f) => Input::Waves(f),
+                Err(e) => Input::Rejected(e),
+            };
+            if tx.blocking_send(msg).is_err() {
+                return false;
+            }
+        }
+        // the link's health comes a second at a time: read at every wake (the interval's too)
+        while let Ok(Some(s)) = self.link.receive() {
+            if tx.blocking_send(Input::Link(*s.payload())).is_err() {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 /// Spawns the daemon's output thread; it ends when the channel closes (after publishing what is left).

@@ -20,10 +20,10 @@ pub fn drive(
     records: &[(f64, Record)],
     mut pace: impl FnMut(f64),
     mut on_output: impl FnMut(crate::ipc::Output),
-) -> Result<crate::service::Counters, Error> {
+) -> Result<crate::engine::Counters, Error> {
+    use crate::engine::{Computer, Engine, rom_options};
     use crate::ipc::{Input, Output};
-    use crate::service::{Computer, Engine, rom_options};
-    crate::service::fits_the_wire(sys)?;
+    crate::engine::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
     let mut computer = Computer::new(model, sys, cfg);

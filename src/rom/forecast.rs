@@ -445,23 +445,7 @@ impl Forecaster {
         let dt = model.opts.dt_s;
         let track = track.unwrap_or_else(|| Track::straight(model.opts.speed_m_s));
         track.validate()?;
-        let mut total = 0.0;
-        self.k_rad_m.clear();
-        for w in waves {
-            if !(w.omega_rad_s.is_finite()
-                && w.omega_rad_s > 0.0
-                && w.heading_rad.is_finite()
-                && w.amplitude_m.re.is_finite()
-                && w.amplitude_m.im.is_finite())
-            {
-                return Err(Error::Input(format!(
-                    "wave component {w:?}: frequency must be positive and every value finite"
-                )));
-            }
-            total += 0.5 * w.amplitude_m.norm_sqr();
-            self.k_rad_m
-                .push(wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m));
-        }
+        let total = self.wave_numbers(model, waves)?;
         self.xbuf.resize(model.n_modes, Complex64::default());
         // per component: left out somewhere (outside the database), quasi-static somewhere, the sign of
         // its encounter frequency in the piece before
@@ -506,93 +490,21 @@ impl Forecaster {
             } else {
                 (psi, [track.speed_m_s, 0.0])
             };
-            self.kept_we.clear();
-            self.kept_x.clear();
-            self.kept_dx.clear();
-            let nm = model.n_modes;
-            for (c, w) in waves.iter().enumerate() {
-                let beta = w.heading_rad - psi;
-                // the start's excitation: the previous piece's end, when it had one
-                let start_known = piece_turns && self.x_ends_known[c];
-                if start_known {
-                    self.xbuf.copy_from_slice(&self.x_ends[c * nm..(c + 1) * nm]);
-                } else if model.db.excitation_into(w.omega_rad_s, beta, &mut self.xbuf).is_err() {
-                    self.marks[c].0 = true;
-                    continue;
-                }
-                if piece_turns {
-                    let end = &mut self.x_ends[c * nm..(c + 1) * nm];
-                    // an end outside the database's headings keeps the start's value over this piece,
-                    // and the next piece looks its start up again (and is left out there)
-                    let known = model
-                        .db
-                        .excitation_into(w.omega_rad_s, w.heading_rad - psi_e, end)
-                        .is_ok();
-                    if !known {
-                        end.copy_from_slice(&self.xbuf);
-                    }
-                    self.x_ends_known[c] = known;
-                }
-                let k = self.k_rad_m[c];
-                let we = if piece_turns {
-                    w.omega_rad_s - k * (v[0] * w.heading_rad.cos() + v[1] * w.heading_rad.sin())
-                } else {
-                    encounter_frequency(w.omega_rad_s, k, track.speed_m_s, beta)
-                };
-                let sign = if we > 0.0 {
-                    1
-                } else if we < 0.0 {
-                    -1
-                } else {
-                    0
-                };
-                let mark = &mut self.marks[c];
-                if we.abs() < slow_rad_s || (mark.2 != 0 && sign != mark.2) {
-                    mark.1 = true;
-                }
-                mark.2 = sign;
-                // the amplitude at the frame's origin at the piece's start
-                let (sd, cd) = w.heading_rad.sin_cos();
-                let a = w.amplitude_m * Complex64::from_polar(1.0, w.omega_rad_s * t_s - k * (p[0] * cd + p[1] * sd));
-                self.kept_we.push(we);
-                for &i in &model.active {
-                    self.kept_x.push(self.xbuf[i] * a);
-                    if piece_turns {
-                        self.kept_dx.push((self.x_ends[c * nm + i] - self.xbuf[i]) * a);
-                    }
-                }
-            }
-            let nc = self.kept_we.len();
-            self.x_rad.clear();
-            self.x_rad.extend(self.kept_we.iter().map(|we| we * dt));
-            transpose_into(&self.kept_x, n, nc, &mut self.q);
-            self.sums
-                .real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.force[k0 * n..k1 * n]);
-            if piece_turns {
-                // + (tau / T) Re{sum dX a exp(i w_e tau)}
-                transpose_into(&self.kept_dx, n, nc, &mut self.q);
-                self.ramp.clear();
-                self.ramp.resize((k1 - k0) * n, 0.0);
-                self.sums.real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.ramp);
-                let len = (k1 - k0) as f64;
-                for (j, row) in self.ramp.chunks(n).enumerate() {
-                    let f = &mut self.force[(k0 + j) * n..(k0 + j + 1) * n];
-                    for (fi, ri) in f.iter_mut().zip(row) {
-                        *fi += j as f64 / len * ri;
-                    }
-                }
-            }
+            let piece = Piece {
+                t_s,
+                psi,
+                psi_e,
+                p,
+                v,
+                turns: piece_turns,
+                speed_m_s: track.speed_m_s,
+                slow_rad_s,
+            };
+            self.piece_components(model, waves, &piece);
+            self.piece_sum(n, dt, k0, k1, piece_turns);
             k0 = k1;
         }
-        let skipped: f64 = waves
-            .iter()
-            .zip(&self.marks)
-            .filter(|(_, m)| m.0)
-            .map(|(w, _)| 0.5 * w.amplitude_m.norm_sqr())
-            .sum();
-        self.out.skipped_components = self.marks.iter().filter(|m| m.0).count();
-        self.out.quasi_static_components = self.marks.iter().filter(|m| m.1 && !m.0).count();
-        self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
+        self.left_out(waves, total);
         if ramp_s > 0.0 {
             for k in 0..=steps {
                 let t = k as f64 * dt;
@@ -604,6 +516,129 @@ impl Forecaster {
             }
         }
         Ok(())
+    }
+
+    /// Checks every component and keeps its wavenumber; the waves' total variance, m^2.
+    fn wave_numbers(&mut self, model: &TimeModel, waves: &[WaveComponent]) -> Result<f64> {
+        let mut total = 0.0;
+        self.k_rad_m.clear();
+        for w in waves {
+            if !(w.omega_rad_s.is_finite()
+                && w.omega_rad_s > 0.0
+                && w.heading_rad.is_finite()
+                && w.amplitude_m.re.is_finite()
+                && w.amplitude_m.im.is_finite())
+            {
+                return Err(Error::Input(format!(
+                    "wave component {w:?}: frequency must be positive and every value finite"
+                )));
+            }
+            total += 0.5 * w.amplitude_m.norm_sqr();
+            self.k_rad_m
+                .push(wave_number(w.omega_rad_s, model.g_m_s2, model.water_depth_m));
+        }
+        Ok(total)
+    }
+
+    /// One piece's kept components: each one's encounter frequency, its excitation times its amplitude
+    /// at the frame's origin at the piece's start (and, turning, the change of that to the piece's end);
+    /// marks what is left out or quasi-static.
+    fn piece_components(&mut self, model: &TimeModel, waves: &[WaveComponent], piece: &Piece) {
+        self.kept_we.clear();
+        self.kept_x.clear();
+        self.kept_dx.clear();
+        let nm = model.n_modes;
+        let (p, v) = (piece.p, piece.v);
+        for (c, w) in waves.iter().enumerate() {
+            let beta = w.heading_rad - piece.psi;
+            // the start's excitation: the previous piece's end, when it had one
+            let start_known = piece.turns && self.x_ends_known[c];
+            if start_known {
+                self.xbuf.copy_from_slice(&self.x_ends[c * nm..(c + 1) * nm]);
+            } else if model.db.excitation_into(w.omega_rad_s, beta, &mut self.xbuf).is_err() {
+                self.marks[c].0 = true;
+                continue;
+            }
+            if piece.turns {
+                let end = &mut self.x_ends[c * nm..(c + 1) * nm];
+                // an end outside the database's headings keeps the start's value over this piece,
+                // and the next piece looks its start up again (and is left out there)
+                let known = model
+                    .db
+                    .excitation_into(w.omega_rad_s, w.heading_rad - piece.psi_e, end)
+                    .is_ok();
+                if !known {
+                    end.copy_from_slice(&self.xbuf);
+                }
+                self.x_ends_known[c] = known;
+            }
+            let k = self.k_rad_m[c];
+            let we = if piece.turns {
+                w.omega_rad_s - k * (v[0] * w.heading_rad.cos() + v[1] * w.heading_rad.sin())
+            } else {
+                encounter_frequency(w.omega_rad_s, k, piece.speed_m_s, beta)
+            };
+            let sign = if we > 0.0 {
+                1
+            } else if we < 0.0 {
+                -1
+            } else {
+                0
+            };
+            let mark = &mut self.marks[c];
+            if we.abs() < piece.slow_rad_s || (mark.2 != 0 && sign != mark.2) {
+                mark.1 = true;
+            }
+            mark.2 = sign;
+            // the amplitude at the frame's origin at the piece's start
+            let (sd, cd) = w.heading_rad.sin_cos();
+            let a = w.amplitude_m * Complex64::from_polar(1.0, w.omega_rad_s * piece.t_s - k * (p[0] * cd + p[1] * sd));
+            self.kept_we.push(we);
+            for &i in &model.active {
+                self.kept_x.push(self.xbuf[i] * a);
+                if piece.turns {
+                    self.kept_dx.push((self.x_ends[c * nm + i] - self.xbuf[i]) * a);
+                }
+            }
+        }
+    }
+
+    /// The kept components' force over steps k0..k1 (and, turning, the linear change of the
+    /// excitation over the piece: + (tau / T) Re{sum dX a exp(i w_e tau)}).
+    fn piece_sum(&mut self, n: usize, dt: f64, k0: usize, k1: usize, turns: bool) {
+        let nc = self.kept_we.len();
+        self.x_rad.clear();
+        self.x_rad.extend(self.kept_we.iter().map(|we| we * dt));
+        transpose_into(&self.kept_x, n, nc, &mut self.q);
+        self.sums
+            .real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.force[k0 * n..k1 * n]);
+        if turns {
+            transpose_into(&self.kept_dx, n, nc, &mut self.q);
+            self.ramp.clear();
+            self.ramp.resize((k1 - k0) * n, 0.0);
+            self.sums.real_sum(&self.x_rad, &self.q, n, k1 - k0, &mut self.ramp);
+            let len = (k1 - k0) as f64;
+            for (j, row) in self.ramp.chunks(n).enumerate() {
+                let f = &mut self.force[(k0 + j) * n..(k0 + j + 1) * n];
+                for (fi, ri) in f.iter_mut().zip(row) {
+                    *fi += j as f64 / len * ri;
+                }
+            }
+        }
+    }
+
+    /// What the marks say of the request: the components left out, the quasi-static ones, and the
+    /// share of the waves' variance (`total`) left out.
+    fn left_out(&mut self, waves: &[WaveComponent], total: f64) {
+        let skipped: f64 = waves
+            .iter()
+            .zip(&self.marks)
+            .filter(|(_, m)| m.0)
+            .map(|(w, _)| 0.5 * w.amplitude_m.norm_sqr())
+            .sum();
+        self.out.skipped_components = self.marks.iter().filter(|m| m.0).count();
+        self.out.quasi_static_components = self.marks.iter().filter(|m| m.1 && !m.0).count();
+        self.out.skipped_variance_fraction = if total > 0.0 { skipped / total } else { 0.0 };
     }
 
     /// The radiation force from the velocities up to t0 (history and v0) at every step, by FFT:
@@ -660,6 +695,21 @@ fn transpose_into(rows: &[Complex64], n: usize, nc: usize, q: &mut Vec<Complex64
             q[i * nc + c] = rows[c * n + i];
         }
     }
+}
+
+/// One piece of the track over which the wave force is summed: its start time (s from t0), the
+/// frame's heading at its start and end (rad), its position at the start (m) and its velocity (m/s,
+/// earth), whether it turns, the speed along the track (m/s) and the encounter frequency below which a
+/// component is quasi-static (rad/s).
+struct Piece {
+    t_s: f64,
+    psi: f64,
+    psi_e: f64,
+    p: [f64; 2],
+    v: [f64; 2],
+    turns: bool,
+    speed_m_s: f64,
+    slow_rad_s: f64,
 }
 
 #[cfg(test)]

@@ -39,7 +39,6 @@ pub mod outputs;
 pub mod partitioned;
 pub mod regular;
 pub mod sinusoids;
-pub mod spread;
 pub mod step;
 pub mod stepper;
 

@@ -111,7 +111,7 @@ pub struct ForecastConfig {
     /// (a radar inversion has one per wavenumber bin, mostly noise; the cost is linear in their number).
     pub wave_variance_kept: f64,
     /// A sample or wave field stamped more than this ahead of its source's clock (as tracked by the
-    /// engine) is refused as from the future, s (`service::clock`).
+    /// engine) is refused as from the future, s (`engine::clock`).
     pub max_clock_skew_s: f64,
     /// ... or more than this behind it, as from the past, s.
     pub max_clock_lag_s: f64,
@@ -169,13 +169,13 @@ impl Default for ForecastConfig {
     }
 }
 
-/// The motion state estimator ([`crate::service::estimator`]): how IMU samples become the state a
+/// The motion state estimator ([`crate::engine::estimator`]): how IMU samples become the state a
 /// forecast starts from.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EstimatorConfig {
     /// "kalman" (filter, smoother, gating, bias) or "raw" (the samples as they come, for comparison).
-    pub method: crate::service::estimator::Method,
+    pub method: crate::engine::estimator::Method,
     /// The motion sensor's noise (standard deviation): displacements, m and rad; velocities, m/s and
     /// rad/s.
     pub noise_m: f64,
@@ -207,7 +207,7 @@ pub struct EstimatorConfig {
 impl Default for EstimatorConfig {
     fn default() -> Self {
         EstimatorConfig {
-            method: crate::service::estimator::Method::Kalman,
+            method: crate::engine::estimator::Method::Kalman,
             noise_m: 0.01,
             noise_rad: 0.0005,
             velocity_noise_m_s: 0.01,
@@ -1107,7 +1107,7 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
     }
     let f = &c.forecast;
     // the default step is the system's (known once it is loaded): the longest it can be stands in
-    crate::service::options_at(c, f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S))
+    crate::engine::options_at(c, f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S))
         .validate()
         .map_err(|e| (format!("forecast.{}", e.field), e.msg))?;
     let dt_s = f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S);

@@ -13,7 +13,7 @@
 //! [`MIN_TREND_SHARE`] of the window give no rate of turn, and positions moved by the mean velocity. The forward speed is the mean speed through the water where the
 //! sensor gives it, else the mean speed over ground projected on the heading (no current known).
 
-use crate::ipc::wire::{NavigationSample, nav_valid};
+use super::message::{NavigationSample, nav_valid};
 use crate::waves::field::heading_from_compass_deg;
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
@@ -199,7 +199,7 @@ impl NavTrack {
 pub fn to_wire(vessel: u32, time_s: f64, fix: &crate::sim::NavFix) -> NavigationSample {
     let compass = |rad: f64| (90.0 - rad.to_degrees()).rem_euclid(360.0);
     NavigationSample {
-        schema_version: crate::ipc::wire::SCHEMA_VERSION,
+        schema_version: super::message::SCHEMA_VERSION,
         vessel,
         time_s,
         east_m: fix.position_m[0],

@@ -1,0 +1,320 @@
+//! The engine's inputs: each sample judged by its source's clock, then by its estimator or track;
+//! what is refused is counted and logged, never taken.
+
+use super::estimator::{Refusal, Taken};
+use super::message::{Input, LinkStatus, MotionSample, NavigationSample, SCHEMA_VERSION, Scan, flags};
+use super::*;
+
+impl Engine {
+    /// One input that arrived at `clock_s` (engine clock). Every stamp is judged against its source's
+    /// clock first ([`clock`]): refused samples never reach the history.
+    pub fn input(&mut self, msg: Input, clock_s: f64) {
+        match msg {
+            Input::Motion(m) => self.motion(m, clock_s),
+            Input::Navigation(n) => self.navigation(n, clock_s),
+            Input::Elevation(scan) => self.elevation(*scan, clock_s),
+            Input::Waves(f) => self.waves(f, clock_s),
+            Input::Link(l) => self.link_status(l, clock_s),
+            Input::Rejected(why) => {
+                self.counters.rejected += 1;
+                tracing::warn!("input rejected: {why}");
+            }
+        }
+    }
+
+    /// A motion sample: judged by its vessel's clock, then by its estimator.
+    fn motion(&mut self, m: MotionSample, clock_s: f64) {
+        let rules = self.clock_rules;
+        let c = &mut self.counters;
+        c.samples += 1;
+        let sample = (m.schema_version, m.vessel, m.time_s);
+        let Some((b, stepped)) = vessel_sample(c, &mut self.motion_clock, "motion sample", sample, clock_s, &rules)
+        else {
+            return;
+        };
+        if stepped {
+            self.state_flags |= flags::CLOCK_STEP;
+            self.hist[b].restart();
+        }
+        match self.hist[b].push(m.time_s, m.x, m.v) {
+            Ok(taken) => {
+                self.arrival[b] = Some(clock_s);
+                if taken == Taken::Restarted {
+                    c.motion_restarts += 1;
+                    self.state_flags |= flags::MOTION_RESTARTED;
+                    tracing::warn!(
+                        vessel = b,
+                        "motion samples that agree with each other but not with the estimate: a real jump, the estimate restarts from them"
+                    );
+                }
+            }
+            Err(Refusal::NonFinite) => {
+                c.nonfinite += 1;
+                log_count(
+                    c.nonfinite,
+                    &format!("vessel {b}: motion sample with a non-finite value refused"),
+                );
+            }
+            Err(Refusal::Late) => {
+                c.late += 1;
+                log_count(
+                    c.late,
+                    &format!("vessel {b}: motion sample older than the newest refused"),
+                );
+            }
+            Err(Refusal::Duplicate) => c.duplicate += 1,
+            Err(why) => {
+                c.implausible += 1;
+                self.state_flags |= flags::MOTION_IMPLAUSIBLE;
+                log_count(
+                    c.implausible,
+                    &format!(
+                        "vessel {b}: motion sample refused as physically impossible: {}",
+                        refusal_text(&why)
+                    ),
+                );
+            }
+        }
+    }
+
+    /// A navigation fix: judged by its vessel's navigation clock, then by its track.
+    fn navigation(&mut self, n: NavigationSample, clock_s: f64) {
+        let rules = self.clock_rules;
+        let c = &mut self.counters;
+        c.navigation += 1;
+        let sample = (n.schema_version, n.vessel, n.time_s);
+        let Some((b, stepped)) = vessel_sample(c, &mut self.nav_clock, "navigation fix", sample, clock_s, &rules)
+        else {
+            return;
+        };
+        if stepped {
+            self.state_flags |= flags::CLOCK_STEP;
+            self.nav[b].restart();
+        }
+        match self.nav[b].push(&n, self.cfg.navigation_window_s) {
+            Ok(()) => {}
+            Err(navigation::NavRefusal::NonFinite) => {
+                c.nonfinite += 1;
+                log_count(
+                    c.nonfinite,
+                    &format!("vessel {b}: navigation fix with a non-finite value refused"),
+                );
+            }
+            Err(navigation::NavRefusal::Late) => {
+                c.late += 1;
+                log_count(
+                    c.late,
+                    &format!("vessel {b}: navigation fix not newer than the newest refused"),
+                );
+            }
+            Err(navigation::NavRefusal::Implausible(what)) => {
+                c.rejected += 1;
+                log_count(
+                    c.rejected,
+                    &format!("vessel {b}: navigation fix refused: its {what} is beyond what a ship does"),
+                );
+            }
+        }
+    }
+
+    /// A radar scan: judged by the radar's clock; a full sequence of scans of one grid is inverted into
+    /// the field.
+    fn elevation(&mut self, scan: Scan, clock_s: f64) {
+        let rules = self.clock_rules;
+        let c = &mut self.counters;
+        c.wave_fields += 1;
+        let Some(stepped) = judge(&mut self.wave_clock, c, "radar scan", scan.grid.time_s, clock_s, &rules) else {
+            return;
+        };
+        if stepped {
+            self.state_flags |= flags::CLOCK_STEP;
+            self.scans.clear();
+        }
+        // a sequence shares one grid at increasing times: another grid starts it again
+        if self.scans.back().is_some_and(|last| {
+            last.frame != scan.frame
+                || last.grid.x_m != scan.grid.x_m
+                || last.grid.y_m != scan.grid.y_m
+                || last.grid.time_s >= scan.grid.time_s
+        }) {
+            self.scans.clear();
+        }
+        self.scans.push_back(scan);
+        while self.scans.len() > self.cfg.radar_snapshots as usize {
+            self.scans.pop_front();
+        }
+        if self.scans.len() < self.cfg.radar_snapshots as usize {
+            return;
+        }
+        let grids: Vec<crate::waves::observe::Grid> = self.scans.iter().map(|s| s.grid.clone()).collect();
+        let frame = self
+            .scans
+            .back()
+            .map(|s| s.frame)
+            .unwrap_or(crate::waves::observe::GridFrame {
+                origin_m: [0.0, 0.0],
+                orientation_rad: 0.0,
+            });
+        match crate::waves::observe::from_scans(&grids, frame, &self.radar_options) {
+            Ok(f) => {
+                let f = f.pruned(self.cfg.wave_variance_kept);
+                if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+                    self.field = Some(f);
+                }
+            }
+            Err(e) => {
+                c.rejected += 1;
+                log_count(c.rejected, &format!("radar scans not inverted: {e}"));
+            }
+        }
+    }
+
+    /// A wave field: its size checked, then judged by the radar's clock.
+    fn waves(&mut self, f: WaveField, clock_s: f64) {
+        let rules = self.clock_rules;
+        let c = &mut self.counters;
+        c.wave_fields += 1;
+        if let Err(why) = message::check_wave_components(f.components.len()) {
+            c.rejected += 1;
+            log_count(c.rejected, &format!("{why}: refused"));
+            return;
+        }
+        let Some(stepped) = judge(&mut self.wave_clock, c, "wave field", f.time_s, clock_s, &rules) else {
+            return;
+        };
+        if stepped {
+            self.state_flags |= flags::CLOCK_STEP;
+        }
+        let f = f.pruned(self.cfg.wave_variance_kept);
+        if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+            self.field = Some(f);
+        }
+    }
+
+    /// The ship-to-ship link's health.
+    fn link_status(&mut self, l: LinkStatus, clock_s: f64) {
+        let c = &mut self.counters;
+        if l.schema_version == message::LINK_SCHEMA_VERSION {
+            self.link = Some((l, clock_s));
+        } else {
+            c.rejected += 1;
+            log_count(
+                c.rejected,
+                &format!("link status of schema version {}: refused", l.schema_version),
+            );
+        }
+    }
+}
+
+/// A stamp judged by its source's clock, counted and logged: None if refused, else whether the source's
+/// clock stepped (and re-synchronized) with it.
+fn judge(
+    source: &mut clock::SourceClock,
+    c: &mut Counters,
+    what: &str,
+    stamp_s: f64,
+    clock_s: f64,
+    rules: &clock::ClockRules,
+) -> Option<bool> {
+    match source.judge(stamp_s, clock_s, rules) {
+        clock::Stamp::Accepted => Some(false),
+        clock::Stamp::Stepped { step_s } => {
+            c.clock_steps += 1;
+            tracing::warn!(
+                step_s,
+                "{what}: the source's clock stepped: re-synchronized, its history restarts"
+            );
+            Some(true)
+        }
+        clock::Stamp::NonFinite => {
+            c.nonfinite += 1;
+            log_count(c.nonfinite, &format!("{what} with a non-finite stamp refused"));
+            None
+        }
+        clock::Stamp::Future { ahead_s } => {
+            c.future += 1;
+            log_count(
+                c.future,
+                &format!("{what} stamped {ahead_s:.3} s ahead of its clock refused"),
+            );
+            None
+        }
+        clock::Stamp::Past { behind_s } => {
+            c.past += 1;
+            log_count(
+                c.past,
+                &format!("{what} stamped {behind_s:.3} s behind its clock refused"),
+            );
+            None
+        }
+    }
+}
+
+/// A vessel's sample (`what`: a motion sample, a navigation fix) of (schema version, vessel index,
+/// stamp): the schema and the index checked against `clocks` (one per vessel), the stamp judged by
+/// the vessel's clock of that kind. None: refused (counted, logged); else the vessel and whether its
+/// clock stepped.
+fn vessel_sample(
+    c: &mut Counters,
+    clocks: &mut [clock::SourceClock],
+    what: &str,
+    (schema_version, vessel, stamp_s): (u32, u32, f64),
+    clock_s: f64,
+    rules: &clock::ClockRules,
+) -> Option<(usize, bool)> {
+    let b = vessel as usize;
+    if schema_version != SCHEMA_VERSION || b >= clocks.len() {
+        c.rejected += 1;
+        log_count(
+            c.rejected,
+            &format!(
+                "{what} refused: schema version {schema_version} (this daemon reads {SCHEMA_VERSION}), vessel {vessel} of {}",
+                clocks.len()
+            ),
+        );
+        return None;
+    }
+    judge(
+        &mut clocks[b],
+        c,
+        &format!("vessel {b}: {what}"),
+        stamp_s,
+        clock_s,
+        rules,
+    )
+    .map(|stepped| (b, stepped))
+}
+
+/// A refusal in words, with the DOF's name and units.
+fn refusal_text(why: &Refusal) -> String {
+    let name = |d: usize| crate::hydro::Dof::of_index(d).output_name();
+    let show = |d: usize, v: f64| crate::hydro::Dof::of_index(d).to_output(v);
+    match *why {
+        Refusal::Bound {
+            dof,
+            what,
+            value,
+            bound,
+        } => {
+            format!(
+                "{} {what} {:.4e} beyond +-{:.4e}",
+                name(dof),
+                show(dof, value),
+                show(dof, bound)
+            )
+        }
+        Refusal::Jump {
+            dof,
+            what,
+            change,
+            allowed,
+        } => format!(
+            "{} {what} changed by {:.4e} since the estimate, at most {:.4e} possible",
+            name(dof),
+            show(dof, change),
+            show(dof, allowed)
+        ),
+        Refusal::Frozen => "the same values as the sample before while the vessel moves (a stalled sensor)".into(),
+        Refusal::NonFinite | Refusal::Late | Refusal::Duplicate => format!("{why:?}"),
+    }
+}

@@ -1,0 +1,279 @@
+//! A forecast job and the computer that runs it: the model (rebuilt for the forward speed when the
+//! system has speed terms), the forecaster and the band.
+
+use super::message::{ForecastHeader, MAX_VESSELS, flags};
+use super::*;
+use crate::band::{ResponseTable, SpreadOptions};
+use crate::rom::{ForecastRequest, Forecaster, Memory, RomOptions, Track};
+
+/// One forecast job.
+#[derive(Debug, Clone)]
+pub struct Job {
+    pub(super) t0_s: f64,
+    pub(super) x0: Vec<f64>,
+    pub(super) v0: Vec<f64>,
+    pub(super) velocities: Vec<Vec<f64>>,
+    /// How many of `velocities` (the newest) were measured, fewest over the vessels.
+    pub(super) known: usize,
+    pub(super) waves: Vec<crate::waves::WaveComponent>,
+    /// Per vessel, per component of `waves`, the leads (s from t0) over which it is known
+    /// (`horizon::known_leads`; none when the field cannot be trusted).
+    pub(super) known_leads: Vec<Vec<[f64; 2]>>,
+    /// Whether the field can be trusted at all (located, navigation fresh).
+    pub(super) trustworthy: bool,
+    /// The model error of each series against lead, as a fraction of its motion
+    /// ([`band::ModelError`]).
+    pub(super) model_error: band::ModelErrorCurve,
+    /// Per series, the variance of the start's random error and its expected error
+    /// ([`band::SpreadOptions`]; the estimator's `start_var` and, for roll and pitch,
+    /// [`band::heel_split`]).
+    pub(super) start_var: Vec<f64>,
+    pub(super) start_offset: Vec<f64>,
+    /// Per series, the estimate's own error variance (`estimator::Estimator::estimate_var`).
+    pub(super) check_var: Vec<f64>,
+    /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
+    pub(super) track: Option<Track>,
+    pub(super) header: ForecastHeader,
+}
+
+/// A job's result.
+#[derive(Debug, Clone)]
+pub struct Done {
+    pub header: ForecastHeader,
+    pub values: Option<Vec<f64>>,
+    pub compute_ms: f64,
+    pub error: Option<String>,
+    /// Share of the wave variance the forecast left out (outside the database), 0..1.
+    pub dropped_wave_share: f64,
+    /// Each series' motion standard deviation by the band's model, and the model error the band took.
+    pub motion_sigma: Vec<f64>,
+    pub model_error: band::ModelErrorCurve,
+    /// Per series, the variance of the start's random error (the band's floor) and of the estimate's
+    /// own error (the filter's: what a check against a later estimate differs by beside the motion;
+    /// the sensor's drift, slow, the two share).
+    pub start_var: Vec<f64>,
+    pub check_var: Vec<f64>,
+    /// The forecast may teach the model error: its waves were trusted and its band known (a forecast
+    /// with no trusted span teaches all the same: its error is the model's).
+    pub teaches: bool,
+}
+
+/// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
+pub struct Computer {
+    model: TimeModel,
+    /// The model's response for the band (None: it could not be made; nothing is trusted then).
+    table: Option<ResponseTable>,
+    trusted_nrmse: f64,
+    /// The system and options to rebuild the model at another speed, when the system file has speed
+    /// terms (`speed_damping` B_U, `speed_restoring` C_UQ) or databases at several speeds (interpolated:
+    /// `VesselSystem::at_speed`); None: one model serves every speed (the speed then enters through the
+    /// encounter frequency only).
+    rebuild: Option<(Box<VesselSystem>, RomOptions)>,
+    /// The speed step a rebuild failed at (not tried again until the speed moves).
+    failed_speed: Option<f64>,
+    fc: Forecaster,
+    n_bodies: usize,
+    /// Forecast length, s.
+    length_s: f64,
+    /// `forecast.drift_window_s` (0: no drift estimate).
+    drift_window_s: f64,
+}
+
+impl Computer {
+    pub fn new(model: TimeModel, sys: &VesselSystem, cfg: &ShipcastConfig) -> Computer {
+        let speed_terms = !sys.speed_dbs.is_empty()
+            || sys.spec.bodies.iter().any(|b| {
+                b.speed_damping
+                    .iter()
+                    .chain(b.speed_restoring.iter())
+                    .any(|v| *v != 0.0)
+            });
+        let n_bodies = sys.spec.bodies.len();
+        Computer {
+            rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
+            failed_speed: None,
+            table: response_table(&model),
+            trusted_nrmse: cfg.forecast.trusted_nrmse,
+            model,
+            fc: Forecaster::new(),
+            n_bodies,
+            length_s: cfg.forecast.horizon_s,
+            drift_window_s: cfg.forecast.drift_window_s,
+        }
+    }
+
+    /// The model at the speed a job's track asks for, rebuilt when the system has speed terms and the
+    /// speed moved to another step of [`MODEL_SPEED_STEP_M_S`]. An error (a speed beyond the databases')
+    /// keeps the model it had, and is reported once per speed step.
+    fn at_speed(&mut self, track: Option<Track>) -> Result<(), String> {
+        let Some((sys, opts)) = &self.rebuild else {
+            return Ok(());
+        };
+        let want = (track.map_or(0.0, |t| t.speed_m_s) / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
+        // a speed between two steps keeps the model it has (no rebuild per forecast on noise)
+        let speed = track.map_or(0.0, |t| t.speed_m_s);
+        let near = (speed - self.model.opts.speed_m_s).abs() <= MODEL_SPEED_HYSTERESIS * MODEL_SPEED_STEP_M_S;
+        if near || (want - self.model.opts.speed_m_s).abs() < 1e-9 || self.failed_speed == Some(want) {
+            return Ok(());
+        }
+        // tried once per speed step: an error is logged once, the model kept
+        self.failed_speed = Some(want);
+        let at = sys
+            .at_speed(want)
+            .map_err(|e| format!("the database at {want} m/s: {e}"))?;
+        let model = TimeModel::new(
+            &at,
+            RomOptions {
+                speed_m_s: want,
+                ..*opts
+            },
+        )
+        .map_err(|e| format!("the model at {want} m/s: {e}"))?;
+        tracing::info!(
+            speed_m_s = want,
+            "model rebuilt for the forward speed (its speed terms)"
+        );
+        self.table = response_table(&model);
+        self.model = model;
+        self.failed_speed = None;
+        // its workspace holds the old model's kernel spectra
+        self.fc = Forecaster::new();
+        Ok(())
+    }
+
+    /// Runs one job; `elapsed_ms` measures its compute time (the shell passes a clock).
+    pub fn run(&mut self, job: Job, elapsed_ms: impl Fn() -> f64) -> Done {
+        if let Err(e) = self.at_speed(job.track) {
+            tracing::warn!("{e}");
+        }
+        let result = self.forecast(&job).map(|(values, steps, dropped, quasi_static)| {
+            let spread = self.band(&job, steps);
+            (values, steps, dropped, quasi_static, spread)
+        });
+        let compute_ms = elapsed_ms();
+        let mut header = job.header;
+        header.compute_ms = compute_ms;
+        header.issue_time_s = job.t0_s;
+        let n_bodies = self.n_bodies;
+        match result {
+            Ok((mut values, steps, dropped_wave_share, quasi_static, spread)) => {
+                header.steps = steps as u32;
+                let mut motion_sigma = vec![];
+                match spread {
+                    Some(s) => {
+                        values.extend_from_slice(&s.sigma);
+                        for b in 0..n_bodies.min(MAX_VESSELS) {
+                            let ok = job.trustworthy && s.to_s[b] > 0.0;
+                            header.horizon_s[b] = if ok { s.to_s[b] } else { 0.0 };
+                            header.trusted_from_s[b] = if ok { s.from_s[b] } else { 0.0 };
+                        }
+                        motion_sigma = s.motion_sigma;
+                    }
+                    None => {
+                        // no band known: not a band of zero
+                        values.extend(std::iter::repeat_n(f64::NAN, 6 * n_bodies * (steps + 1)));
+                        header.horizon_s = [0.0; MAX_VESSELS];
+                        header.trusted_from_s = [0.0; MAX_VESSELS];
+                    }
+                }
+                if quasi_static > 0 {
+                    header.flags |= flags::QUASI_STATIC_WAVES;
+                }
+                Done {
+                    header,
+                    values: Some(values),
+                    compute_ms,
+                    error: None,
+                    dropped_wave_share,
+                    teaches: job.trustworthy && !motion_sigma.is_empty(),
+                    motion_sigma,
+                    model_error: job.model_error,
+                    start_var: job.start_var,
+                    check_var: job.check_var,
+                }
+            }
+            Err(e) => Done {
+                header,
+                values: None,
+                compute_ms,
+                error: Some(e.to_string()),
+                dropped_wave_share: 0.0,
+                motion_sigma: vec![],
+                model_error: job.model_error,
+                start_var: job.start_var,
+                check_var: job.check_var,
+                teaches: false,
+            },
+        }
+    }
+
+    /// The job's forecast: its displacements series-major, the steps, the wave variance left out and
+    /// the quasi-static components.
+    #[allow(clippy::type_complexity)]
+    fn forecast(&mut self, job: &Job) -> crate::rom::Result<(Vec<f64>, usize, f64, usize)> {
+        let (model, n_bodies) = (&self.model, self.n_bodies);
+        let fc = &mut self.fc;
+        let drift = (self.drift_window_s > 0.0)
+            .then(|| {
+                crate::rom::drift::slow_velocity(
+                    &job.velocities,
+                    job.known,
+                    &job.v0,
+                    model.opts.dt_s,
+                    self.drift_window_s,
+                )
+            })
+            .flatten();
+        Memory::from_history(model, &job.velocities).and_then(|memory| {
+            let req = ForecastRequest {
+                x0: &job.x0,
+                v0: &job.v0,
+                memory: &memory,
+                waves: &job.waves,
+                length_s: self.length_s,
+                ramp_s: 0.0,
+                drift_velocity: drift.as_deref(),
+                track: job.track,
+            };
+            fc.forecast(model, &req).map(|f| {
+                let mut values = Vec::with_capacity(6 * n_bodies * (f.steps + 1));
+                for i in 0..6 * n_bodies {
+                    values.extend((0..=f.steps).map(|k| f.at(k, i)));
+                }
+                (values, f.steps, f.skipped_variance_fraction, f.quasi_static_components)
+            })
+        })
+    }
+
+    /// The job's band and trusted span over `steps` (None without the response table: nothing trusted).
+    fn band(&self, job: &Job, steps: usize) -> Option<band::Spread> {
+        let opts = SpreadOptions {
+            model_error: job.model_error.clone(),
+            trusted_nrmse: self.trusted_nrmse,
+            start_var: job.start_var.clone(),
+            start_offset: job.start_offset.clone(),
+        };
+        let model = &self.model;
+        self.table.as_ref().map(|table| {
+            band::spread(
+                table,
+                &job.waves,
+                &job.known_leads,
+                self.n_bodies,
+                job.track.map_or(0.0, |t| t.speed_m_s),
+                model.g_m_s2,
+                model.water_depth_m,
+                steps,
+                model.opts.dt_s,
+                &opts,
+            )
+        })
+    }
+}
+
+/// The model's response table for the band, or None (logged) where its equations are singular.
+fn response_table(model: &TimeModel) -> Option<ResponseTable> {
+    ResponseTable::of(model)
+        .map_err(|e| tracing::warn!("no band for the forecasts (nothing will be trusted): {e}"))
+        .ok()
+}
