@@ -49,7 +49,7 @@ omega_max_rad_s = 1.3
 # the plumbing under test, not the sensors: the truth is the model's own (damping 1.2 x), the radar
 # sees the whole disc without shadowing or bound waves and the IMU does not drift, so that a slip of
 # the pipeline (a time shift, a frame) shows in the correlation; the realistic sea is replay's
-# (tests/replay.rs) and the README's matrix
+# (tests/replay.rs) and the sea-state matrix (docs/skill.md)
 bound_waves = false
 [simulate.imu]
 drift_m = 0.0

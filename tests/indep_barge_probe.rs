@@ -11,7 +11,7 @@ use std::path::Path;
 /// The skill the published span promises (issue 28: correlation >= 0.8 inside it).
 const MIN_CORRELATION: f64 = 0.8;
 /// The 90 % band's coverage allowed over the span on a 25-minute record (its first minutes use the
-/// configured prior while the model error is learnt; the README gives the figures).
+/// configured prior while the model error is learnt; docs/skill.md gives the figures).
 const COVERAGE: std::ops::RangeInclusive<f64> = 0.75..=0.99;
 /// At the defaults the window holds every group of the band that reaches the barge within a minute:
 /// the span starts at once and reaches at least a minute.

@@ -210,7 +210,7 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
 }
 
 /// The 90 % band's coverage allowed on a 10-minute log: its first minutes use the configured prior
-/// while the model error is learnt (README, "How far a forecast is trusted": the 30-minute figures).
+/// while the model error is learnt (docs/skill.md: the 30-minute figures).
 const SHORT_LOG_COVERAGE: std::ops::RangeInclusive<f64> = 0.7..=1.0;
 /// ... and at lead 0, where nothing is learnt from the prior: the Show's (measured 0.90 heave, 0.94
 /// pitch; 0.93 and 0.98 when the band there was floored at the sensor's noise and learnt from checks

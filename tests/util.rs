@@ -44,7 +44,7 @@ pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: 
 /// Edits of `config/shipcast.toml` (for [`simulated_with`]) that make its synthetic sea a twin
 /// experiment: the truth the forecaster's own model (damping 1.2 x), a radar disc seen whole without
 /// shadowing or bound waves, IMUs that do not drift. For tests of a pipeline (a slip of time, frame
-/// or pose shows in the correlation), not of skill: the shipped sensors are the README's matrix's.
+/// or pose shows in the correlation), not of skill: the shipped sensors are the sea-state matrix's (docs/skill.md).
 pub const TWIN_SEA: [(&str, &str); 7] = [
     ("truth_system = \"vessels/", "# truth_system = \"vessels/"),
     ("bound_waves = true ", "bound_waves = false "),

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""How far one log's `coverage_90` strays from 0.90 when the band is exactly right (README, "How far a
-forecast is trusted"). The error is a sum of a slow part (a first-order Gauss-Markov process of
+"""How far one log's `coverage_90` strays from 0.90 when the band is exactly right (docs/skill.md,
+"The band and the span"). The error is a sum of a slow part (a first-order Gauss-Markov process of
 correlation time TAU, as an IMU's drift) and a white part, of total variance 1; the band is the
 normal 90 % band of that variance; a log of DURATION seconds scored once a second. Prints, over RUNS
 draws, the mean coverage, its 5-95 % range, and how often it falls inside 0.85-0.95 and above 0.95.

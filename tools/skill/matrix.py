@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The skill of shipcast's forecasts over a matrix of synthetic sea states (issue 28; README, "How far a
-forecast is trusted"). Each case is `shipcast simulate --record` of the config with some keys changed
+"""The skill of shipcast's forecasts over a matrix of synthetic sea states (issue 28; docs/skill.md,
+"The sea-state matrix"). Each case is `shipcast simulate --record` of the config with some keys changed
 (SHIPCAST_* environment variables), then `shipcast replay --report`; the table is Markdown, printed and
 written to OUTDIR/matrix.md, each case's report kept in OUTDIR/<case>.
 
