@@ -3,7 +3,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::files::load_system;
-use shipcast::hydro::memory::system_irf;
+use shipcast::radiation::memory::system_irf;
 use shipcast::rao::FrequencySolver;
 use std::hint::black_box;
 use std::path::Path;

@@ -17,6 +17,7 @@ pub mod ipc;
 pub mod link;
 pub mod operation;
 pub mod process;
+pub mod radiation;
 pub mod rao;
 pub mod record;
 pub mod replay;

@@ -1,5 +1,5 @@
 //! `shipcast db check`'s report: what a system file and its database hold, what the checks found
-//! ([`crate::hydro::check`]), the state-space model the time domain runs, each radiation model's floor
+//! ([`crate::radiation::check`]), the state-space model the time domain runs, each radiation model's floor
 //! against the database's frequency domain, and the warnings. [`DbCheck::new`] computes it from a loaded
 //! system; its `Display` is the text `db check` prints (the binary adds the total time).
 //!
@@ -7,15 +7,14 @@
 //! state-space fit, for the report.
 
 use crate::files::Loaded;
-use crate::hydro::check::{self, CheckReport};
 use crate::hydro::external::ConnectionKind;
-use crate::hydro::memory;
-use crate::hydro::radiation::{self, PairError};
-use crate::hydro::statespace::ModalModel;
 use crate::hydro::system::{AInfSource, Passivity, TailChoice};
 use crate::hydro::{Dof, VesselSystem, mode_label};
+use crate::radiation::check::{self, CheckReport};
+use crate::radiation::irf::{self, PairError};
+use crate::radiation::memory;
+use crate::radiation::statespace::ModalModel;
 use crate::rao::FrequencySolver;
-use crate::rom::model::Kernel;
 use crate::rom::{RadiationMethod, RomOptions, TimeModel, floor};
 use std::f64::consts::PI;
 use std::fmt;
@@ -108,13 +107,10 @@ impl<'a> DbCheck<'a> {
         };
         let ss_model = TimeModel::new(sys, model_opts(RadiationMethod::StateSpace));
         let state_space = match &ss_model {
-            Ok(
-                m @ TimeModel {
-                    kernel: Kernel::StateSpace { model: ss, .. },
-                    ..
-                },
-            ) => StateSpace::Fitted(Box::new(state_space_fit(sys, m, ss, t_fit))),
-            Ok(_) => StateSpace::NotBuilt,
+            Ok(m) => match m.kernel.modal_model() {
+                Some(ss) => StateSpace::Fitted(Box::new(state_space_fit(sys, m, ss, t_fit))),
+                None => StateSpace::NotBuilt,
+            },
             Err(e) => StateSpace::NoFit(e.to_string()),
         };
         let (lo, hi) = db.omega_range();
@@ -426,8 +422,8 @@ impl DbCheck<'_> {
             report.irf.dt_s,
             report.irf.duration_s(),
             w[w.len() - 1],
-            radiation::TAIL_FAR_POWER,
-            radiation::TAIL_POWER,
+            irf::TAIL_FAR_POWER,
+            irf::TAIL_POWER,
         )?;
         match report.tail_fit_residuals {
             Some((cubic, fitted)) => writeln!(
@@ -505,7 +501,7 @@ impl DbCheck<'_> {
         let mut kk = report.kk.clone();
         kk.sort_by(|a, b| b.added_mass_band.total_cmp(&a.added_mass_band));
         let worst = |f: fn(&PairError) -> f64| kk.iter().map(f).fold(0.0, f64::max);
-        let band = radiation::KK_BAND_FRACTION * w[w.len() - 1];
+        let band = irf::KK_BAND_FRACTION * w[w.len() - 1];
         writeln!(
             out,
             "Kramers-Kronig (A, B rebuilt from K; error / sqrt(scale_ii scale_jj)): worst A {:.3} % up to {band:.3} rad/s, {:.3} % over all; worst B {:.3} %",

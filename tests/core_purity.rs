@@ -20,6 +20,7 @@ const CORE: &[&str] = &[
     "src/rom",
     "src/engine",
     "src/band",
+    "src/radiation",
     "src/skill.rs",
     "src/sim.rs",
     "src/operation.rs",

@@ -3,11 +3,11 @@
 //! (WAMIT). Errors are max over w <= 0.8 w_max of |A_K - A| / sqrt(max|A_ii| max|A_jj|).
 
 use shipcast::files::load_system;
-use shipcast::hydro::check::choose_a_inf;
-use shipcast::hydro::memory::system_irf;
-use shipcast::hydro::radiation::{kramers_kronig, ogilvie_a_inf, ogilvie_estimates};
 use shipcast::hydro::system::TailChoice;
 use shipcast::hydro::{Dof, VesselSystem};
+use shipcast::radiation::check::choose_a_inf;
+use shipcast::radiation::irf::{kramers_kronig, ogilvie_a_inf, ogilvie_estimates};
+use shipcast::radiation::memory::system_irf;
 
 use crate::util::repo;
 
@@ -43,7 +43,7 @@ fn check(rel: &str, tol_any_db: f64) {
     let with_db = kramers_kronig(&sys.db, &irf, &a_inf);
     let with_og = kramers_kronig(&sys.db, &irf, &og);
     assert!(!with_db.is_empty());
-    let worst = |v: &[shipcast::hydro::radiation::PairError], f: &dyn Fn(usize, usize) -> bool| {
+    let worst = |v: &[shipcast::radiation::irf::PairError], f: &dyn Fn(usize, usize) -> bool| {
         v.iter()
             .filter(|e| f(e.i, e.j))
             .map(|e| e.added_mass_band)

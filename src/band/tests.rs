@@ -1,4 +1,3 @@
-
 use super::*;
 use crate::waves::WaveComponent;
 use num_complex::Complex64;

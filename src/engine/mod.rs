@@ -179,12 +179,9 @@ pub struct Engine {
 impl Engine {
     pub fn new(cfg: &ShipcastConfig, sys: &VesselSystem, model: &TimeModel) -> Engine {
         let n_bodies = sys.spec.bodies.len();
-        let taps = match &model.kernel {
-            crate::rom::model::Kernel::Convolution { taps, .. } => *taps,
-            crate::rom::model::Kernel::StateSpace { .. } => {
-                (cfg.forecast.memory_s.unwrap_or(STATE_SPACE_HISTORY_S) / model.opts.dt_s).round() as usize
-            }
-        };
+        let taps = model.kernel.taps().unwrap_or_else(|| {
+            (cfg.forecast.memory_s.unwrap_or(STATE_SPACE_HISTORY_S) / model.opts.dt_s).round() as usize
+        });
         let keep_s = taps as f64 * model.opts.dt_s + cfg.forecast.history_margin_s;
         let (_, heading) = vessel_positions(cfg, sys);
         Engine {

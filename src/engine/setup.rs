@@ -49,7 +49,7 @@ pub fn history_wanted_s(cfg: &ShipcastConfig, sys: &VesselSystem) -> f64 {
     match (cfg.forecast.memory_s, cfg.forecast.radiation.as_str()) {
         (Some(m), _) => m,
         (None, "state-space") => STATE_SPACE_HISTORY_S,
-        (None, _) => crate::hydro::memory::memory_duration_s(sys),
+        (None, _) => crate::radiation::memory::memory_duration_s(sys),
     }
 }
 

@@ -15,12 +15,8 @@
 //! - Excitation X(w, beta) is the force per metre of wave amplitude referred to the wave phase at the
 //!   database's global origin.
 
-pub mod check;
 pub mod db;
 pub mod external;
-pub mod memory;
-pub mod radiation;
-pub mod statespace;
 pub mod system;
 pub mod wamit;
 

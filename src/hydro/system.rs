@@ -16,7 +16,7 @@ use super::{Dof, Error, Result};
 use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3};
 use serde::Deserialize;
 
-/// The damping tail beyond the database's last frequency ([`super::radiation::DampingTail`]).
+/// The damping tail beyond the database's last frequency ([`crate::radiation::irf::DampingTail`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum TailChoice {
@@ -34,7 +34,7 @@ pub enum TailChoice {
 #[serde(rename_all = "lowercase")]
 pub enum Passivity {
     /// Negative eigenvalues set to zero at each frequency (the smallest change that makes B passive;
-    /// [`super::radiation::passive_damping`]), the default: a passive K can never make a stable hull
+    /// [`crate::radiation::irf::passive_damping`]), the default: a passive K can never make a stable hull
     /// unstable.
     #[default]
     Project,
@@ -147,7 +147,7 @@ struct BodyFile {
     active_dofs: Option<Vec<String>>,
 }
 
-/// Impulse-response options (see [`super::radiation`]).
+/// Impulse-response options (see [`crate::radiation::irf`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IrfOptions {
     /// Time step of the sampled K(t), s. Default 0.05 s.
@@ -358,7 +358,7 @@ fn irf_options(f: Option<&IrfFile>) -> std::result::Result<IrfOptions, (&'static
     let mut irf = IrfOptions::default();
     if let Some(f) = f {
         if let Some(dt) = f.dt_s {
-            super::radiation::check_dt(dt).map_err(|e| ("irf.dt_s", e.to_string()))?;
+            crate::radiation::irf::check_dt(dt).map_err(|e| ("irf.dt_s", e.to_string()))?;
             irf.dt_s = dt;
         }
         if let Some(d) = f.duration_s {
@@ -645,8 +645,8 @@ impl VesselSystem {
         let memory_s = spec
             .irf
             .duration_s
-            .unwrap_or_else(|| super::radiation::default_duration_s(&db));
-        super::radiation::check_grid(spec.irf.dt_s, memory_s).map_err(|e| Error::Key {
+            .unwrap_or_else(|| crate::radiation::irf::default_duration_s(&db));
+        crate::radiation::irf::check_grid(spec.irf.dt_s, memory_s).map_err(|e| Error::Key {
             file: file.into(),
             key: "irf".into(),
             msg: e.to_string(),

@@ -32,7 +32,7 @@ pub fn columns(m: &DMatrix<f64>) -> Vec<f64> {
     out
 }
 
-/// a b + c, fused when the version is compiled with FMA (shared with [`super::modal`]'s kernels).
+/// a b + c, fused when the version is compiled with FMA (shared with [`crate::radiation::modal`]'s kernels).
 #[inline(always)]
 pub(crate) fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     if FMA { a.mul_add(b, c) } else { a * b + c }

@@ -1,11 +1,11 @@
 //! The forecaster: state and history in, motion out (pure; no clock, no IO). A repeated forecast of
 //! the same size allocates nothing: the workspace is kept between calls (rapier's habit).
 
-use super::memory::Memory;
 use super::model::{Kernel, TimeModel};
 use super::sinusoids::Sinusoids;
 use super::stepper::Stepper;
 use super::{Error, Result};
+use crate::radiation::history::Memory;
 use crate::waves::{WaveComponent, encounter_frequency, wave_number};
 use num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
@@ -196,7 +196,7 @@ pub struct Forecaster {
     ramp: Vec<f64>,
     f0: Vec<f64>,
     // FFT of the kernel (convolution with a history), built on first use; the forecast's own
-    // velocities are the stepper's ([`super::partitioned`])
+    // velocities are the stepper's ([`crate::radiation::partitioned`])
     fft: Option<HistoryFft>,
 }
 

@@ -4,7 +4,7 @@
 //!   (M + A_inf) x'' + (B_lin + B_U U) x' + B_Q |x'| x' + (C + C_UQ U^2) x + int_0^T K(tau) x'(t - tau) dtau
 //!       = F_wave(t)
 //! Conventions: SI units; DOF order surge..yaw per vessel (vessel k owns 6k..6k+5); inactive DOFs are
-//! held at zero; K(t) from the database's damping made passive ([`crate::hydro::radiation`]); A_inf by
+//! held at zero; K(t) from the database's damping made passive ([`crate::radiation::irf`]); A_inf by
 //! Ogilvie's relation from that same K (consistent with it), or the database's when the system file says
 //! `a_inf = "database"`. Zero-speed database: K and X are those at U = 0, the
 //! forcing runs at the encounter frequency.
@@ -23,7 +23,7 @@
 //!
 //! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
 //! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs,
-//! [`partitioned`]) or the modal state-space model ([`crate::hydro::statespace`]: vector fit, balanced
+//! [`partitioned`]) or the modal state-space model ([`crate::radiation::statespace`]: vector fit, balanced
 //! truncation, passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
@@ -32,18 +32,15 @@ pub mod dense;
 pub mod drift;
 pub mod floor;
 pub mod forecast;
-pub mod memory;
-pub mod modal;
 pub mod model;
 pub mod outputs;
-pub mod partitioned;
 pub mod regular;
 pub mod sinusoids;
 pub mod step;
 pub mod stepper;
 
+pub use crate::radiation::history::Memory;
 pub use forecast::{Forecast, ForecastRequest, Forecaster, Track};
-pub use memory::Memory;
 pub use model::{OptionError, RadiationMethod, RomOptions, TimeModel};
 
 /// Errors of the time-domain model.

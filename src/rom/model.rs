@@ -1,14 +1,14 @@
 //! The assembled time-domain model of a vessel system over its active DOFs (pure).
 
-use super::modal::ModalStep;
-use super::partitioned::{Partitions, block_for};
 use super::{Error, Result};
-use crate::hydro::memory::{
+use crate::hydro::{HydroDb, VesselSystem};
+use crate::radiation::irf;
+use crate::radiation::memory::{
     RadiationMemory, active_radiation, memory_duration_s, model_a_inf, radiation_memory, state_space_memory,
 };
-use crate::hydro::radiation;
-use crate::hydro::statespace::{ModalModel, ModalOptions};
-use crate::hydro::{HydroDb, VesselSystem};
+use crate::radiation::modal::ModalStep;
+use crate::radiation::partitioned::{Partitions, block_for};
+use crate::radiation::statespace::{ModalModel, ModalOptions};
 use nalgebra::DMatrix;
 
 /// How the radiation memory is evaluated.
@@ -68,17 +68,17 @@ pub struct OptionError {
 
 impl RomOptions {
     /// The one check of the options, for every caller (the configuration, the CLI, scenarios and
-    /// [`TimeModel::new`]): the step in [`radiation::MIN_DT_S`]..[`radiation::MAX_DT_S`], the memory (when
-    /// given) in (0, [`radiation::MAX_MEMORY_S`]] and at most [`radiation::MAX_TAPS`] steps long, beta in
+    /// [`TimeModel::new`]): the step in [`irf::MIN_DT_S`]..[`irf::MAX_DT_S`], the memory (when
+    /// given) in (0, [`irf::MAX_MEMORY_S`]] and at most [`irf::MAX_TAPS`] steps long, beta in
     /// (0, 1/2], |speed| at most [`MAX_SPEED_M_S`], the fit tolerance in (0, 1).
     pub fn validate(&self) -> std::result::Result<(), OptionError> {
-        let grid = |e: radiation::GridError| OptionError {
+        let grid = |e: irf::GridError| OptionError {
             field: e.field(),
             msg: e.to_string(),
         };
-        radiation::check_dt(self.dt_s).map_err(grid)?;
+        irf::check_dt(self.dt_s).map_err(grid)?;
         if let Some(m) = self.memory_s {
-            radiation::check_grid(self.dt_s, m).map_err(grid)?;
+            irf::check_grid(self.dt_s, m).map_err(grid)?;
         }
         if !(self.beta > 0.0 && self.beta <= 0.5) {
             return Err(OptionError {
@@ -112,7 +112,7 @@ impl RomOptions {
 #[derive(Debug, Clone)]
 pub enum Kernel {
     /// `k[(i * taps + m) * n + j] = dt w_m K_m(i, j)`, trapezoid weights w_0 = w_last = 1/2; `parts`: the
-    /// taps from one block on in the frequency domain, for a run's own velocities ([`super::partitioned`]).
+    /// taps from one block on in the frequency domain, for a run's own velocities ([`crate::radiation::partitioned`]).
     Convolution {
         taps: usize,
         k: Vec<f64>,
@@ -123,6 +123,25 @@ pub enum Kernel {
         model: Box<ModalModel>,
         step: Box<ModalStep>,
     },
+}
+
+impl Kernel {
+    /// The measured velocities the convolution reads (its taps); None for the state-space model,
+    /// whose modal states carry the memory.
+    pub fn taps(&self) -> Option<usize> {
+        match self {
+            Kernel::Convolution { taps, .. } => Some(*taps),
+            Kernel::StateSpace { .. } => None,
+        }
+    }
+
+    /// The fitted modal model of the state-space radiation; None for the convolution.
+    pub fn modal_model(&self) -> Option<&ModalModel> {
+        match self {
+            Kernel::Convolution { .. } => None,
+            Kernel::StateSpace { model, .. } => Some(model),
+        }
+    }
 }
 
 /// Scratch for [`TimeModel::nonlinear_force`].
@@ -181,14 +200,14 @@ pub struct TimeModel {
     pub g_m_s2: f64,
     pub water_depth_m: Option<f64>,
     /// The convolution's IRF (active DOFs, unweighted) for the implied frequency response.
-    irf: Option<radiation::Irf>,
+    irf: Option<irf::Irf>,
 }
 
 /// The convolution's kernel: K's taps at the solver's step `dt` weighted by the trapezoidal rule, over
 /// the `n` active states (`hyd` reads a hydrodynamic matrix there, zero on tank states), and the
 /// instantaneous part (tap 0).
 fn convolution_kernel(
-    irf_all: &radiation::Irf,
+    irf_all: &irf::Irf,
     hyd: &dyn Fn(&DMatrix<f64>, usize, usize) -> f64,
     n: usize,
     dt: f64,
@@ -209,13 +228,8 @@ fn convolution_kernel(
 }
 
 /// K over the `n` active states (unweighted) on the solver's step `dt`.
-fn active_irf(
-    irf_all: &radiation::Irf,
-    hyd: &dyn Fn(&DMatrix<f64>, usize, usize) -> f64,
-    n: usize,
-    dt: f64,
-) -> radiation::Irf {
-    radiation::Irf {
+fn active_irf(irf_all: &irf::Irf, hyd: &dyn Fn(&DMatrix<f64>, usize, usize) -> f64, n: usize, dt: f64) -> irf::Irf {
+    irf::Irf {
         dt_s: dt,
         k: irf_all
             .k
@@ -231,7 +245,7 @@ fn active_irf(
 fn state_space_kernel(
     sys: &VesselSystem,
     a_inf_all: &DMatrix<f64>,
-    tail: &radiation::DampingTail,
+    tail: &irf::DampingTail,
     opts: &RomOptions,
     n: usize,
     damping: &mut DMatrix<f64>,
@@ -295,7 +309,7 @@ impl TimeModel {
             RadiationMethod::StateSpace => sys.spec.irf.dt_s,
             _ => dt,
         };
-        radiation::check_grid(grid_dt, memory_s).map_err(|e| OptionError {
+        irf::check_grid(grid_dt, memory_s).map_err(|e| OptionError {
             field: e.field(),
             msg: e.to_string(),
         })?;
@@ -397,7 +411,7 @@ impl TimeModel {
         let n = self.n();
         let v0: Vec<f64> = (0..n).map(|r| 0.01 / (1.0 + r as f64)).collect();
         let x0 = vec![0.0; n];
-        let memory = super::memory::Memory::new(self);
+        let memory = crate::radiation::history::Memory::new(self);
         let memory_s = match &self.kernel {
             Kernel::Convolution { taps, .. } => *taps as f64 * self.opts.dt_s,
             Kernel::StateSpace { .. } => 300.0,
@@ -459,8 +473,8 @@ impl TimeModel {
                 })
             }
             (_, Some(irf)) => {
-                let c = radiation::transform_irf(irf, &[omega_rad_s], false);
-                let s = radiation::transform_irf(irf, &[omega_rad_s], true);
+                let c = irf::transform_irf(irf, &[omega_rad_s], false);
+                let s = irf::transform_irf(irf, &[omega_rad_s], true);
                 DMatrix::from_fn(self.n(), self.n(), |i, j| {
                     num_complex::Complex64::new(c[0][(i, j)], -s[0][(i, j)])
                 })

@@ -9,10 +9,10 @@
 //! remains is then below that level. A linear model runs every frequency at once (multi-sine, unit
 //! amplitude each: superposition holds); a model with quadratic damping runs one frequency at a time.
 
-use super::memory::Memory;
 use super::model::TimeModel;
 use super::stepper::Stepper;
 use super::{Error, ForecastRequest, Forecaster, Result};
+use crate::radiation::history::Memory;
 use crate::waves::{WaveComponent, encounter_frequency, wave_number};
 use nalgebra::DMatrix;
 use num_complex::Complex64;

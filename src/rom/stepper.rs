@@ -3,10 +3,10 @@
 //! The stepper owns only reusable workspace; what it reads comes in as arguments.
 
 use super::dense;
-use super::memory::Memory;
 use super::model::{Kernel, NlScratch, TimeModel};
-use super::partitioned::PartitionedRun;
 use super::{Error, Result};
+use crate::radiation::history::Memory;
+use crate::radiation::partitioned::PartitionedRun;
 use multiversion::multiversion;
 
 /// Displacement beyond which a state counts as unbounded (m or rad).
@@ -28,7 +28,7 @@ pub struct Stepper {
     /// Convolution: the run's velocities (v_1 on) against the taps beyond one block.
     run: PartitionedRun,
     /// State space: the modes' states (r real parts, then r imaginary parts), held one half-update
-    /// ahead during a run (see [`super::modal`]), and their input b . v at the start, laid out alike.
+    /// ahead during a run (see [`crate::radiation::modal`]), and their input b . v at the start, laid out alike.
     states: Vec<f64>,
     beta: Vec<f64>,
     /// State space: the radiation force the states give at the next step (all but the new velocity's).
@@ -193,7 +193,7 @@ impl Stepper {
 }
 
 /// [`Stepper::step`], compiled for AVX2 + FMA as well as the baseline and chosen at run time (its
-/// short loops over the DOFs; the products are [`dense`]'s, the modal update [`super::modal`]'s).
+/// short loops over the DOFs; the products are [`dense`]'s, the modal update [`crate::radiation::modal`]'s).
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn step_dispatched(st: &mut Stepper, model: &TimeModel, f1: &[f64], known: &[f64]) -> Result<()> {
     st.step_body(model, f1, known)

@@ -235,8 +235,8 @@ fn cmac(h_re: &[f64], h_im: &[f64], x_re: &[f64], x_im: &[f64], acc_re: &mut [f6
     let (acc_re, acc_im) = (&mut acc_re[..m], &mut acc_im[..m]);
     for f in 0..m {
         let (hr, hi, xr, xi) = (h_re[f], h_im[f], x_re[f], x_im[f]);
-        acc_re[f] = super::dense::madd::<FMA>(hr, xr, super::dense::madd::<FMA>(-hi, xi, acc_re[f]));
-        acc_im[f] = super::dense::madd::<FMA>(hr, xi, super::dense::madd::<FMA>(hi, xr, acc_im[f]));
+        acc_re[f] = crate::rom::dense::madd::<FMA>(hr, xr, crate::rom::dense::madd::<FMA>(-hi, xi, acc_re[f]));
+        acc_im[f] = crate::rom::dense::madd::<FMA>(hr, xi, crate::rom::dense::madd::<FMA>(hi, xr, acc_im[f]));
     }
 }
 

@@ -1,4 +1,4 @@
-//! The exact discrete update of a modal radiation model ([`crate::hydro::statespace`]) over the solver's step,
+//! The exact discrete update of a modal radiation model ([`crate::radiation::statespace`]) over the solver's step,
 //! laid out for the stepper's inner loop (pure).
 //!
 //! Each complex mode xi' = lambda xi + beta(t) with beta = b . v linear over the step (first-order hold,
@@ -12,8 +12,8 @@
 //! over the modes, the force in a second):
 //! y_{k+2} = E (y_{k+1} + g1 beta_{k+1}) + g0 beta_{k+1} = E y_{k+1} + h beta_{k+1}, h = E g1 + g0.
 
-use super::dense::{self, madd};
-use crate::hydro::statespace::ModalModel;
+use crate::radiation::statespace::ModalModel;
+use crate::rom::dense::{self, madd};
 use multiversion::multiversion;
 use multiversion::target::target_cfg_f;
 use nalgebra::DMatrix;

@@ -27,7 +27,7 @@
 //!   frequencies of A(w) + (1/w) int_0^T K(t) sin(w t) dt, which makes A(w) and B(w) as the model sees
 //!   them consistent. Its spread over w is reported (a flat estimate means a consistent database).
 
-use super::HydroDb;
+use crate::hydro::HydroDb;
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 

@@ -5,8 +5,8 @@
 //! sample with [`Memory::push`] (the daemon does this as measurements arrive, once per sample) or from a
 //! whole history with [`Memory::from_history`].
 
-use super::model::{Kernel, TimeModel};
-use super::{Error, Result};
+use crate::rom::model::{Kernel, TimeModel};
+use crate::rom::{Error, Result};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Memory {

@@ -5,10 +5,10 @@
 //! ([`crate::rom::TimeModel`]) and `db check`'s report ([`super::check`]) both read it from here, so the
 //! report describes the model that runs.
 
-use super::VesselSystem;
-use super::radiation::{self, DampingTail, Irf};
+use super::irf::{self as radiation, DampingTail, Irf};
 use super::statespace;
-use super::system::{AInfSource, Passivity, TailChoice};
+use crate::hydro::VesselSystem;
+use crate::hydro::system::{AInfSource, Passivity, TailChoice};
 use nalgebra::DMatrix;
 
 /// The radiation memory the time-domain models use: K(t) on t = 0, dt, ..., duration from the

@@ -35,7 +35,7 @@
 //! xi_{k+1} = E xi_k + g0 beta_k + g1 beta_{k+1}, E = exp(lambda h), g1 = (E - 1 - lambda h)/(lambda^2 h),
 //! g0 = (E - 1)/lambda - g1.
 
-use super::radiation::DampingTail;
+use super::irf::DampingTail;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
@@ -167,8 +167,8 @@ pub fn fit_errors(
     a_inf: &DMatrix<f64>,
 ) -> (f64, f64) {
     let n = a_inf.nrows();
-    let sb = super::radiation::diagonal_peaks(damping);
-    let sa = super::radiation::diagonal_peaks(added_mass);
+    let sb = super::irf::diagonal_peaks(damping);
+    let sa = super::irf::diagonal_peaks(added_mass);
     let (mut eb, mut ea) = (0.0f64, 0.0f64);
     for ((w, b), a) in omegas.iter().zip(damping).zip(added_mass) {
         let k = model.kernel(*w);
@@ -207,7 +207,7 @@ fn fit_rows(omegas: &[f64]) -> (Vec<f64>, Vec<(usize, bool)>) {
     // sparse tail lets a spurious lightly damped pole sit just above the band)
     let mut step = (wn - omegas[nw - 2]).max(1e-3 * wn);
     let mut x = wn + step;
-    while x <= super::radiation::TAIL_END_FACTOR * wn {
+    while x <= super::irf::TAIL_END_FACTOR * wn {
         rows.push((freqs.len(), false));
         freqs.push(x);
         step *= TAIL_SPREAD;
@@ -274,12 +274,9 @@ pub fn fit(
     }
     // a DOF that does not radiate (damping zero or noise: `radiation::radiating_dofs`) takes the
     // smallest scale of one that does, so that nothing divides by zero
-    let peaks = super::radiation::diagonal_peaks(damping);
+    let peaks = super::irf::diagonal_peaks(damping);
     let top = peaks.iter().copied().fold(0.0, f64::max);
-    let scale: Vec<f64> = peaks
-        .iter()
-        .map(|p| p.max(super::radiation::NON_RADIATING * top))
-        .collect();
+    let scale: Vec<f64> = peaks.iter().map(|p| p.max(super::irf::NON_RADIATING * top)).collect();
     let sc = |i: usize, j: usize| (scale[i] * scale[j]).sqrt();
     // the upper triangle, scaled: entry e = (i, j), data[e][k]
     let entries: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
@@ -1094,7 +1091,7 @@ mod tests {
         };
         let tail = DampingTail::cubic(&ws, &b);
         let m = fit(&ws, &b, &a, &ai, &tail, opts).unwrap();
-        let scale = super::super::radiation::diagonal_peaks(&b);
+        let scale = super::super::irf::diagonal_peaks(&b);
         let mut worst = 0.0f64;
         for w in &ws {
             let (kt, kf) = (k(*w), m.kernel(*w));

@@ -3,11 +3,11 @@
 //! the state-space fit's errors. The radiation memory they check is built in [`super::memory`], as the
 //! time-domain models build it.
 
-use super::VesselSystem;
+use super::irf::{self as radiation, DampingTail, Irf, PairError};
 use super::memory::{RadiationMemory, active_radiation, system_memory};
-use super::radiation::{self, DampingTail, Irf, PairError};
 use super::statespace;
-use super::system::AInfSource;
+use crate::hydro::VesselSystem;
+use crate::hydro::system::AInfSource;
 use nalgebra::DMatrix;
 
 /// What `db check` reports.
