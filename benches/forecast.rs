@@ -9,10 +9,10 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shipcast::band::{ModelErrorCurve, ResponseTable, SpreadOptions, spread};
-use shipcast::files::load_system;
 use shipcast::rom::stepper::Stepper;
 use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel, Track};
-use shipcast::scenario::{Prepared, Scenario, past_options, prepare};
+use shipcast::shell::files::load_system;
+use shipcast::shell::scenario::{Prepared, Scenario, past_options, prepare};
 use std::hint::black_box;
 use std::path::Path;
 

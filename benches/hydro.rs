@@ -2,9 +2,9 @@
 //! impulse response functions of its database. Setup (loading files) is outside the timing.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shipcast::files::load_system;
 use shipcast::radiation::memory::system_irf;
 use shipcast::rao::FrequencySolver;
+use shipcast::shell::files::load_system;
 use std::hint::black_box;
 use std::path::Path;
 

@@ -6,8 +6,8 @@
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use shipcast::files;
-use shipcast::report::DbCheck;
+use shipcast::shell::files;
+use shipcast::shell::report::DbCheck;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -358,7 +358,7 @@ fn config_with_env(section: &str, key: &str, value: &str, env: &[(&str, &str)]) 
     let path = dir.join("shipcast.toml");
     std::fs::write(&path, out.join("\n")).unwrap();
     let env: Vec<(String, String)> = env.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    let r = shipcast::service::config::load_with_env(&path, &env)
+    let r = shipcast::shell::config::load_with_env(&path, &env)
         .map(|_| ())
         .map_err(|e| e.to_string());
     let _ = std::fs::remove_dir_all(&dir);
@@ -497,6 +497,6 @@ fn the_shipped_configurations_are_within_bounds() {
         "config/one-ship.toml",
         "tests/data/replay-v1/shipcast.toml",
     ] {
-        shipcast::service::config::load_with_env(&repo(f), &[]).unwrap_or_else(|e| panic!("{e}"));
+        shipcast::shell::config::load_with_env(&repo(f), &[]).unwrap_or_else(|e| panic!("{e}"));
     }
 }

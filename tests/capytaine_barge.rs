@@ -38,7 +38,7 @@ fn rao(method: &str, radiation: &str, omegas: &str) -> (Vec<RaoRow>, String) {
 }
 
 fn check(radiation: &str, tol: f64) {
-    let sys = shipcast::files::load_system(&repo(SYSTEM)).unwrap().system;
+    let sys = shipcast::shell::files::load_system(&repo(SYSTEM)).unwrap().system;
     let step = shipcast::rom::step::default_step(&sys);
     assert_eq!(step.dt_s, 0.04, "{}", step.describe(&sys));
     let headings: Vec<f64> = HEADINGS_DEG.split(',').map(|h| h.parse().unwrap()).collect();

@@ -8,8 +8,8 @@
 //! `tools/bem/check_speed_interp.py` measures the same in Python.
 
 use crate::util::repo;
-use shipcast::files::load_system;
 use shipcast::hydro::{HydroDb, VesselSystem};
+use shipcast::shell::files::load_system;
 
 const DIR: &str = "tests/data/capytaine-barge-speeds";
 /// A curve whose peak is below this share of its mode's (A, B: the geometric mean of the two

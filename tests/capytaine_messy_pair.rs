@@ -128,7 +128,7 @@ fn damping_that_creates_energy_is_refused_as_it_is_and_projected_by_default() {
         dt_s: 0.05,
         ..shipcast::rom::RomOptions::default()
     };
-    let raw = shipcast::files::load_system(&ship_with_negative_damping(&dir, "passivity = \"none\"\n"))
+    let raw = shipcast::shell::files::load_system(&ship_with_negative_damping(&dir, "passivity = \"none\"\n"))
         .unwrap()
         .system;
     let err = shipcast::rom::TimeModel::new(&raw, opts()).unwrap_err().to_string();
@@ -136,7 +136,7 @@ fn damping_that_creates_energy_is_refused_as_it_is_and_projected_by_default() {
         err.contains("irf.passivity") && (err.contains("grew") || err.contains("diverged")),
         "{err}"
     );
-    let projected = shipcast::files::load_system(&ship_with_negative_damping(&dir, "passivity = \"project\"\n"))
+    let projected = shipcast::shell::files::load_system(&ship_with_negative_damping(&dir, "passivity = \"project\"\n"))
         .unwrap()
         .system;
     assert!(shipcast::rom::TimeModel::new(&projected, opts()).is_ok());

@@ -3,7 +3,7 @@
 //! simulator's truth; fault cases. Each test uses its own service prefix, so they run in parallel.
 
 use crate::util::repo;
-use shipcast::process::Interrupting;
+use shipcast::shell::process::Interrupting;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -341,17 +341,17 @@ fn a_config_with_a_wrong_key_or_type_is_refused() {
     assert!(!out.status.success() && err.contains("forecast.dt_s"), "{err}");
 }
 
-fn status_of(r: &shipcast::ipc::Received) -> Option<shipcast::ipc::wire::Status> {
+fn status_of(r: &shipcast::shell::ipc::Received) -> Option<shipcast::shell::ipc::wire::Status> {
     match r {
-        shipcast::ipc::Received::Status(s) => Some(*s),
+        shipcast::shell::ipc::Received::Status(s) => Some(*s),
         _ => None,
     }
 }
 
 #[test]
 fn faults_are_counted_flagged_and_survived() {
-    use shipcast::ipc::wire::{MotionSample, SCHEMA_VERSION, flags};
-    use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
+    use shipcast::shell::ipc::wire::{MotionSample, SCHEMA_VERSION, flags};
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
     use shipcast::waves::field::{FieldComponent, Region, WaveField};
     let dir = crate::util::scratch_dir("daemon-faults");
     let cfg = config(&dir, "faults", "");
@@ -387,13 +387,13 @@ fn faults_are_counted_flagged_and_survived() {
         x: [0.0, 0.0, v, 0.0, 0.0, 0.0],
         v: [0.0; 6],
     };
-    let t_start = shipcast::service::wall_s();
+    let t_start = shipcast::shell::daemon::wall_s();
     let mut got = vec![];
     let run_for = |p: &SensorPublisher, secs: f64, waves: bool, got: &mut Vec<Received>| {
         let t = Instant::now();
         let mut k = 0;
         while t.elapsed().as_secs_f64() < secs {
-            let now = shipcast::service::wall_s();
+            let now = shipcast::shell::daemon::wall_s();
             p.motion(&sample(now, 0.1)).unwrap();
             if waves && k % 10 == 0 {
                 p.waves(&field(now)).unwrap();
@@ -407,7 +407,7 @@ fn faults_are_counted_flagged_and_survived() {
         let p = SensorPublisher::new(&names).unwrap();
         run_for(&p, 3.0, true, &mut got);
         // bad samples: NaN, duplicate, out of order
-        let now = shipcast::service::wall_s();
+        let now = shipcast::shell::daemon::wall_s();
         p.motion(&sample(now, f64::NAN)).unwrap();
         p.motion(&sample(now, 0.1)).unwrap();
         p.motion(&sample(now, 0.1)).unwrap();
@@ -464,7 +464,7 @@ fn faults_are_counted_flagged_and_survived() {
 
 #[test]
 fn a_killed_sensor_process_can_restart_and_the_daemon_resumes() {
-    use shipcast::ipc::{ForecastSubscriber, Names, Received};
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
     let dir = crate::util::scratch_dir("daemon-kill");
     let cfg = config(&dir, "kill", "");
     let names = Names {
@@ -551,7 +551,7 @@ fn a_python_console_decodes_a_live_forecast() {
     let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), 2);
     // the config sets no step: the system's default (rom::step), 60 s of it
-    let sys = shipcast::files::load_system(&repo("config/vessels/ship/system.toml"))
+    let sys = shipcast::shell::files::load_system(&repo("config/vessels/ship/system.toml"))
         .unwrap()
         .system;
     let dt_s = shipcast::rom::step::default_step(&sys).dt_s;
@@ -576,7 +576,7 @@ fn a_python_console_decodes_a_live_forecast() {
 
 #[test]
 fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
-    use shipcast::record::{Record, read};
+    use shipcast::shell::record::{Record, read};
     let dir = crate::util::scratch_dir("daemon-record");
     let rec_dir = dir.join("logs");
     let cfg = config(&dir, "record", &format!("[record]\ndir = \"{}\"\n", rec_dir.display()));
@@ -591,7 +591,7 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
         .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
         .collect();
     assert_eq!(logs.len(), 1, "{logs:?}");
-    let forecasts_of = |p: &Path| -> Vec<shipcast::record::ForecastRecord> {
+    let forecasts_of = |p: &Path| -> Vec<shipcast::shell::record::ForecastRecord> {
         read(p)
             .unwrap()
             .records
@@ -650,7 +650,7 @@ fn a_recorded_live_run_replays_to_the_same_forecasts_bit_for_bit() {
 
 #[test]
 fn a_killed_daemon_restarts_and_forecasts_again() {
-    use shipcast::ipc::{ForecastSubscriber, Names, Received};
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
     let dir = crate::util::scratch_dir("daemon-restart");
     let cfg = config(&dir, "restart", "");
     let names = Names {
@@ -685,7 +685,7 @@ fn a_panic_in_the_compute_thread_ends_the_daemon_with_an_error() {
     let cfg = config(&dir, "panic", "");
     let mut d = Command::new(bin())
         .args(["run", "--config", cfg.to_str().unwrap()])
-        .env(shipcast::service::FAULT_ENV, "compute-panic")
+        .env(shipcast::shell::daemon::FAULT_ENV, "compute-panic")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()

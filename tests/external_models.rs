@@ -6,10 +6,10 @@ use crate::util::{repo, scratch_dir, write_flat_database};
 use nalgebra::{Matrix2, Vector2};
 use num_complex::Complex64;
 use proptest::prelude::*;
-use shipcast::files::load_system;
 use shipcast::rao::FrequencySolver;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
 use shipcast::rom::{ForecastRequest, Forecaster, Memory, RomOptions, TimeModel};
+use shipcast::shell::files::load_system;
 use shipcast::waves::WaveComponent;
 use std::f64::consts::PI;
 

@@ -2,12 +2,12 @@
 //! database's B(w)) against the BEM's own A(w), on the demo databases (Capytaine) and WEC-Sim's RM3
 //! (WAMIT). Errors are max over w <= 0.8 w_max of |A_K - A| / sqrt(max|A_ii| max|A_jj|).
 
-use shipcast::files::load_system;
 use shipcast::hydro::system::TailChoice;
 use shipcast::hydro::{Dof, VesselSystem};
 use shipcast::radiation::check::choose_a_inf;
 use shipcast::radiation::irf::{kramers_kronig, ogilvie_a_inf, ogilvie_estimates};
 use shipcast::radiation::memory::system_irf;
+use shipcast::shell::files::load_system;
 
 use crate::util::repo;
 

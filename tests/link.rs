@@ -8,9 +8,9 @@
 //! back, both link processes running.
 
 use crate::util::repo;
-use shipcast::ipc::wire::{Status, flags, link_state};
-use shipcast::ipc::{ForecastSubscriber, Names, Received};
-use shipcast::process::Interrupting;
+use shipcast::shell::ipc::wire::{Status, flags, link_state};
+use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
+use shipcast::shell::process::Interrupting;
 use std::io::{Read, Write};
 use std::net::{Shutdown, TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
@@ -239,14 +239,15 @@ fn two_hosts_over_zenoh_survive_a_cut_link() {
         dir.display()
     );
 
-    let forecasts = |v: &[(f64, Received)], from: f64, to: f64| -> Vec<(f64, shipcast::ipc::wire::ForecastHeader)> {
-        v.iter()
-            .filter_map(|(t, r)| match r {
-                Received::Forecast(h, _) if *t >= from && *t < to => Some((*t, *h)),
-                _ => None,
-            })
-            .collect()
-    };
+    let forecasts =
+        |v: &[(f64, Received)], from: f64, to: f64| -> Vec<(f64, shipcast::shell::ipc::wire::ForecastHeader)> {
+            v.iter()
+                .filter_map(|(t, r)| match r {
+                    Received::Forecast(h, _) if *t >= from && *t < to => Some((*t, *h)),
+                    _ => None,
+                })
+                .collect()
+        };
     let statuses = |v: &[(f64, Received)], from: f64, to: f64| -> Vec<(f64, Status)> {
         v.iter()
             .filter_map(|(t, r)| match r {
@@ -255,7 +256,7 @@ fn two_hosts_over_zenoh_survive_a_cut_link() {
             })
             .collect()
     };
-    let stale = |h: &shipcast::ipc::wire::ForecastHeader| h.flags & flags::STALE_MOTION != 0;
+    let stale = |h: &shipcast::shell::ipc::wire::ForecastHeader| h.flags & flags::STALE_MOTION != 0;
 
     // before the cut: the lighter's motion came from B, the forecasts reached B
     let before = forecasts(&at_a, 22.0, cut_at);

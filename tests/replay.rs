@@ -42,7 +42,7 @@ const MIN_SKILL_DROP_PAST_REACH: f64 = 0.2;
 fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
     let dir = scratch_dir("replay-skill");
     let (cfg, log) = simulated_log(&dir, 600);
-    let run = |name: &str| -> (serde_json::Value, Vec<shipcast::record::ForecastRecord>) {
+    let run = |name: &str| -> (serde_json::Value, Vec<shipcast::shell::record::ForecastRecord>) {
         let rep = dir.join(name);
         let out = dir.join(format!("{name}.mcap"));
         let (ok, stdout, err) = shipcast(&[
@@ -123,12 +123,12 @@ fn replay_is_deterministic_and_skill_falls_past_the_horizon() {
                 "trusted horizon",
             ],
         );
-        let forecasts: Vec<shipcast::record::ForecastRecord> = shipcast::record::read(&out)
+        let forecasts: Vec<shipcast::shell::record::ForecastRecord> = shipcast::shell::record::read(&out)
             .unwrap()
             .records
             .into_iter()
             .filter_map(|(_, r)| match r {
-                shipcast::record::Record::Forecast(f) => Some(f),
+                shipcast::shell::record::Record::Forecast(f) => Some(f),
                 _ => None,
             })
             .collect();
@@ -310,7 +310,7 @@ fn damaged_logs_keep_what_is_readable_and_newer_schemas_are_refused() {
         let mut w = mcap::WriteOptions::new().create(f).unwrap();
         let sid = w.add_schema("shipcast.Motion", "jsonschema", b"{}").unwrap();
         let mut meta = std::collections::BTreeMap::new();
-        let newer_version = shipcast::record::LOG_SCHEMA_VERSION + 1;
+        let newer_version = shipcast::shell::record::LOG_SCHEMA_VERSION + 1;
         meta.insert("shipcast_schema_version".to_string(), newer_version.to_string());
         let ch = w.add_channel(sid, "/motion", "json", &meta).unwrap();
         w.write_to_known_channel(
@@ -328,8 +328,10 @@ fn damaged_logs_keep_what_is_readable_and_newer_schemas_are_refused() {
     let (ok, _, err) = shipcast(&["replay", newer.to_str().unwrap(), "--config", cfg.to_str().unwrap()]);
     assert!(!ok);
     assert!(
-        err.contains(&format!("schema version {}", shipcast::record::LOG_SCHEMA_VERSION + 1))
-            && err.contains("upgrade shipcast"),
+        err.contains(&format!(
+            "schema version {}",
+            shipcast::shell::record::LOG_SCHEMA_VERSION + 1
+        )) && err.contains("upgrade shipcast"),
         "{err}"
     );
 }
@@ -339,7 +341,7 @@ const ROTATE_EVERY_S: f64 = 10.0;
 
 #[test]
 fn logs_rotate_by_log_time_and_every_message_is_kept() {
-    use shipcast::record::{LogInfo, MotionRecord, Record, RotatingRecorder, read};
+    use shipcast::shell::record::{LogInfo, MotionRecord, Record, RotatingRecorder, read};
     let dir = scratch_dir("rotate-time");
     let mut r = RotatingRecorder::new(&dir, 1000.0, Some(ROTATE_EVERY_S), LogInfo::default()).unwrap();
     for k in 0..350 {
@@ -376,7 +378,7 @@ const PROBE_MIN_CORRELATION_10S: f64 = 0.8;
 
 #[test]
 fn csv_recordings_import_and_replay_without_code() {
-    use shipcast::record::{Record, read};
+    use shipcast::shell::record::{Record, read};
     let dir = scratch_dir("import");
     let (cfg, log) = simulated_log(&dir, 400);
     let records = read(&log).unwrap().records;
@@ -514,7 +516,7 @@ fn csv_recordings_import_and_replay_without_code() {
 
 #[test]
 fn a_replay_publishes_for_a_console() {
-    use shipcast::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
+    use shipcast::shell::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
     use std::time::{Duration, Instant};
     let dir = scratch_dir("replay-publish");
     let (cfg, log) = simulated_log(&dir, 150);
@@ -522,7 +524,7 @@ fn a_replay_publishes_for_a_console() {
     let names = Names { prefix: prefix.clone() };
     let fs = ForecastSubscriber::new(&names).unwrap();
     let ms = MotionSubscriber::new(&names).unwrap();
-    let _replay = shipcast::process::Interrupting(
+    let _replay = shipcast::shell::process::Interrupting(
         std::process::Command::new(env!("CARGO_BIN_EXE_shipcast"))
             .args(["replay", log.to_str().unwrap(), "--config", cfg.to_str().unwrap()])
             .args(["--speed", "10", &format!("--publish={prefix}")])
@@ -642,7 +644,7 @@ fn a_corrupt_chunk_header_is_read_up_to_the_damage_in_bounded_time() {
 
 #[test]
 fn a_log_time_gap_replays_in_time_proportional_to_its_messages() {
-    use shipcast::record::{LogInfo, MotionRecord, Record, Recorder, read};
+    use shipcast::shell::record::{LogInfo, MotionRecord, Record, Recorder, read};
     let dir = scratch_dir("replay-gap");
     let (cfg, log) = v1_fixture();
     let mut records = read(&log).unwrap().records;
@@ -673,7 +675,7 @@ fn a_log_time_gap_replays_in_time_proportional_to_its_messages() {
 
 #[test]
 fn a_version_1_log_still_replays_to_the_same_forecasts() {
-    use shipcast::record::{ForecastRecord, Record, read};
+    use shipcast::shell::record::{ForecastRecord, Record, read};
     let dir = scratch_dir("replay-v1");
     let (cfg, log) = v1_fixture();
     let out = dir.join("replayed.mcap");

@@ -5,9 +5,9 @@
 use crate::util::{RaoRow, parse_rao_csv, repo, shipcast};
 use num_complex::Complex64;
 use proptest::prelude::*;
-use shipcast::files::load_system;
 use shipcast::hydro::VesselSystem;
 use shipcast::rom::{Forecast, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use shipcast::shell::files::load_system;
 use shipcast::waves::WaveComponent;
 use std::collections::HashMap;
 
@@ -274,7 +274,7 @@ const FORECAST_VELOCITY_AGREE_TOL: f64 = 0.01;
 
 #[test]
 fn two_ship_forecasts_from_the_same_past_agree() {
-    use shipcast::scenario::{Scenario, past_options, prepare};
+    use shipcast::shell::scenario::{Scenario, past_options, prepare};
     let sc = Scenario::load(&repo("config/scenarios/two-ship.toml")).unwrap();
     let sys = load_system(&sc.system).unwrap().system;
     let model = |radiation| TimeModel::new(&sys, RomOptions { radiation, ..sc.opts }).unwrap();

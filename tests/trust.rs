@@ -4,9 +4,9 @@
 //! (`util::ONE_SHIP_TWIN_SEA`: faults against a clean baseline, whose forecasts are trusted), made once.
 
 use crate::util::{ONE_SHIP_TWIN_SEA, SimLog, simulated_with};
-use shipcast::ipc::Output;
-use shipcast::ipc::wire::{ForecastHeader, Status, flags};
-use shipcast::replay::{self, Record};
+use shipcast::shell::ipc::Output;
+use shipcast::shell::ipc::wire::{ForecastHeader, Status, flags};
+use shipcast::shell::replay::{self, Record};
 use std::sync::OnceLock;
 
 /// Simulated seconds in the log.

@@ -7,9 +7,9 @@
 //! closed the 5 m gap by 22 m.
 
 use crate::util::{SimLog, TWIN_SEA, simulated_with};
-use shipcast::ipc::Output;
-use shipcast::ipc::wire::ForecastHeader;
-use shipcast::replay::{self, Record};
+use shipcast::shell::ipc::Output;
+use shipcast::shell::ipc::wire::ForecastHeader;
+use shipcast::shell::replay::{self, Record};
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
@@ -365,7 +365,11 @@ fn a_vessel_whose_motion_stops_is_forecast_from_rest_and_trusted_nowhere() {
     assert!(out.len() >= 50, "{} forecasts during the outage", out.len());
     for f in &out {
         let h = &f.header;
-        assert!(h.flags & shipcast::ipc::wire::flags::STALE_MOTION != 0, "{:?}", h.flags);
+        assert!(
+            h.flags & shipcast::shell::ipc::wire::flags::STALE_MOTION != 0,
+            "{:?}",
+            h.flags
+        );
         assert_eq!(h.horizon_s[1], 0.0);
     }
     let rms = |fs: &[Forecast], v: usize, d: usize, lead_s: f64| -> f64 {

@@ -8,11 +8,11 @@
 
 use crate::util::{SimLog, TWIN_SEA, simulated_with};
 use num_complex::Complex64;
-use shipcast::files::load_system;
-use shipcast::ipc::Output;
-use shipcast::ipc::wire::{ForecastHeader, flags};
-use shipcast::replay::{self, Record};
 use shipcast::rom::{Forecaster, RomOptions, TimeModel, Track};
+use shipcast::shell::files::load_system;
+use shipcast::shell::ipc::Output;
+use shipcast::shell::ipc::wire::{ForecastHeader, flags};
+use shipcast::shell::replay::{self, Record};
 use shipcast::waves::field::{FieldComponent, Region, WaveField};
 use shipcast::waves::{WaveComponent, horizon, wave_number};
 use std::collections::BTreeMap;

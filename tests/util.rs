@@ -12,9 +12,9 @@ pub fn repo(rel: &str) -> PathBuf {
 /// Runs the `shipcast` binary; returns (success, stdout, stderr).
 /// A simulated log with the configuration and system that made it.
 pub struct SimLog {
-    pub cfg: shipcast::service::config::ShipcastConfig,
+    pub cfg: shipcast::shell::config::ShipcastConfig,
     pub sys: shipcast::hydro::VesselSystem,
-    pub records: Vec<(f64, shipcast::replay::Record)>,
+    pub records: Vec<(f64, shipcast::shell::replay::Record)>,
 }
 
 /// `secs` simulated seconds of `config/<config>` (whose `[system] file` must be `system`, relative to
@@ -33,11 +33,11 @@ pub fn simulated_with(name: &str, config: &str, system: &str, secs: f64, edits: 
     let path = dir.join("sim.mcap");
     simulate_to(&cfg_path, &path, secs);
     SimLog {
-        cfg: shipcast::service::config::load(&cfg_path).unwrap(),
-        sys: shipcast::files::load_system(&repo(&format!("config/{system}")))
+        cfg: shipcast::shell::config::load(&cfg_path).unwrap(),
+        sys: shipcast::shell::files::load_system(&repo(&format!("config/{system}")))
             .unwrap()
             .system,
-        records: shipcast::replay::read(&path).unwrap().records,
+        records: shipcast::shell::replay::read(&path).unwrap().records,
     }
 }
 

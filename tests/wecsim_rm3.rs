@@ -68,7 +68,7 @@ const MIN_HEAVE_GAIN2: f64 = 0.01;
 /// zeros. Now the uncovered headings have no response, and the covered one has RM3's heave.
 #[test]
 fn wecsim_rm3_single_heading_database_has_a_band() {
-    let sys = shipcast::files::load_system(&crate::util::repo("tests/data/wecsim-rm3/system.toml"))
+    let sys = shipcast::shell::files::load_system(&crate::util::repo("tests/data/wecsim-rm3/system.toml"))
         .unwrap()
         .system;
     let model = shipcast::rom::TimeModel::new(&sys, shipcast::rom::RomOptions::default()).unwrap();

@@ -9,8 +9,8 @@
 use crate::util::repo;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use shipcast::files::load_system;
 use shipcast::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use shipcast::shell::files::load_system;
 use shipcast::waves::WaveComponent;
 
 /// The bar for forces: 1 % of each series' peak.

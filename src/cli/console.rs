@@ -6,8 +6,8 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use shipcast::console::{Action, Console, Forecast, Health, Key, Settings};
-use shipcast::ipc::wire::{SCHEMA_VERSION, flags};
-use shipcast::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
+use shipcast::shell::ipc::wire::{SCHEMA_VERSION, flags};
+use shipcast::shell::ipc::{ForecastSubscriber, MotionSubscriber, Names, Received};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
@@ -72,7 +72,8 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                     Received::Forecast(h, v) => {
                         let n = h.steps as usize + 1;
                         let nv = (h.n_vessels as usize).min(n_vessels);
-                        if h.schema_version != shipcast::ipc::wire::FORECAST_SCHEMA_VERSION || v.len() < 2 * 6 * nv * n
+                        if h.schema_version != shipcast::shell::ipc::wire::FORECAST_SCHEMA_VERSION
+                            || v.len() < 2 * 6 * nv * n
                         {
                             continue;
                         }
@@ -94,7 +95,7 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                         })
                     }
                     Received::Status(s) => {
-                        if s.schema_version != shipcast::ipc::wire::STATUS_SCHEMA_VERSION {
+                        if s.schema_version != shipcast::shell::ipc::wire::STATUS_SCHEMA_VERSION {
                             continue;
                         }
                         let nv = n_vessels.min(s.motion_age_s.len());
@@ -107,9 +108,9 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                             overruns: s.overruns,
                             running: s.running != 0,
                             received_wall_s: now,
-                            link: (s.link_state != shipcast::ipc::wire::link_state::NONE).then_some(
+                            link: (s.link_state != shipcast::shell::ipc::wire::link_state::NONE).then_some(
                                 shipcast::console::LinkHealth {
-                                    up: s.link_state == shipcast::ipc::wire::link_state::UP,
+                                    up: s.link_state == shipcast::shell::ipc::wire::link_state::UP,
                                     latency_ms: s.link_latency_ms,
                                     loss: s.link_loss,
                                     age_s: s.link_age_s,
@@ -134,7 +135,7 @@ pub fn run(a: &ConsoleArgs) -> Result<()> {
 
 /// The console on a loaded config and system (also what `shipcast demo` opens in a terminal).
 pub fn view(
-    cfg: &shipcast::service::config::ShipcastConfig,
+    cfg: &shipcast::shell::config::ShipcastConfig,
     sys: &shipcast::hydro::VesselSystem,
     prefix: Option<String>,
     seconds: Option<f64>,
@@ -165,7 +166,7 @@ pub fn view(
     };
     let thread = {
         let stop = stop.clone();
-        let n = vessels.len().min(shipcast::ipc::wire::MAX_VESSELS);
+        let n = vessels.len().min(shipcast::shell::ipc::wire::MAX_VESSELS);
         std::thread::Builder::new()
             .name("console-subscriptions".into())
             .spawn(move || subscribe(names, n, tx, stop))

@@ -3,12 +3,12 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::engine::vessel_positions;
-use shipcast::files;
 use shipcast::hydro::{Dof, VesselSystem};
-use shipcast::ipc::wire::{Status, flags};
-use shipcast::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
-use shipcast::service::config::{self, ShipcastConfig};
-use shipcast::service::{self, to_wire};
+use shipcast::shell::config::{self, ShipcastConfig};
+use shipcast::shell::daemon::{self, to_wire};
+use shipcast::shell::files;
+use shipcast::shell::ipc::wire::{Status, flags};
+use shipcast::shell::ipc::{ForecastSubscriber, Names, Received, SensorPublisher};
 use shipcast::sim::{ImuSpec, RadarSpec, SimSpec, Simulation};
 use shipcast::waves::field::heading_from_compass_deg;
 use shipcast::waves::sea::{SeaState, Spreading};
@@ -92,8 +92,8 @@ pub fn run(cfg: ShipcastConfig) -> Result<()> {
         .build()?;
     let stop = Arc::new(AtomicBool::new(false));
     rt.block_on(async {
-        let shutdown = service::shutdown_signals()?;
-        service::run(cfg, sys, stop, shutdown).await
+        let shutdown = daemon::shutdown_signals()?;
+        daemon::run(cfg, sys, stop, shutdown).await
     })
     .map_err(|e| anyhow::anyhow!("{e}"))
 }
@@ -186,7 +186,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
     let mut out = SimOutputs::open(a, &cfg, &sys, sim.n_bodies)?;
     // the data clock: UNIX seconds at the start (simulate.start_unix_s, default the wall clock), then
     // simulation time; published and recorded stamps and log times are on it
-    let epoch = cfg.simulate.start_unix_s.unwrap_or_else(service::wall_s);
+    let epoch = cfg.simulate.start_unix_s.unwrap_or_else(daemon::wall_s);
     let imu_dt = 1.0 / cfg.simulate.imu.rate_hz;
     let radar_dt = cfg.simulate.radar.period_s;
     let (mut next_imu, mut next_radar) = (0.0f64, 0.0f64);
@@ -266,7 +266,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
 struct SimOutputs {
     publisher: Option<SensorPublisher>,
     elsewhere: Vec<(u32, SensorPublisher)>,
-    recorder: Option<shipcast::record::Recorder<std::io::BufWriter<std::fs::File>>>,
+    recorder: Option<shipcast::shell::record::Recorder<std::io::BufWriter<std::fs::File>>>,
     truth_out: Option<std::io::BufWriter<std::fs::File>>,
     n_bodies: usize,
 }
@@ -312,9 +312,9 @@ impl SimOutputs {
         };
         let recorder = match &a.record {
             Some(p) => Some(
-                shipcast::record::Recorder::create(
+                shipcast::shell::record::Recorder::create(
                     p,
-                    &shipcast::record::LogInfo::of(cfg, &cfg.system.file, sys, "simulate"),
+                    &shipcast::shell::record::LogInfo::of(cfg, &cfg.system.file, sys, "simulate"),
                 )
                 .map_err(|e| anyhow::anyhow!("{e}"))?,
             ),
@@ -347,8 +347,12 @@ impl SimOutputs {
                 p.navigation(&n)
                     .map_err(|e| anyhow::anyhow!("publishing navigation: {e}"))?;
             } else if let Some(rec) = self.recorder.as_mut() {
-                rec.write("/navigation", t + epoch, &shipcast::record::NavigationRecord::of(&n))
-                    .map_err(|e| anyhow::anyhow!("{e}"))?;
+                rec.write(
+                    "/navigation",
+                    t + epoch,
+                    &shipcast::shell::record::NavigationRecord::of(&n),
+                )
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
             }
         }
         Ok(())
@@ -384,15 +388,15 @@ impl SimOutputs {
 /// Records the simulator's output at `t` (log time `t + epoch`): with `radar`, a scan's field and, every
 /// `grid_every` scans (counted in `scans`), its elevation grid; else the IMU samples and the true motion.
 fn record_step(
-    rec: &mut shipcast::record::Recorder<std::io::BufWriter<std::fs::File>>,
+    rec: &mut shipcast::shell::record::Recorder<std::io::BufWriter<std::fs::File>>,
     sim: &mut Simulation,
     t: f64,
     epoch: f64,
     radar: bool,
     (grid_every, scans): (u32, &mut u64),
     grid_output: bool,
-) -> std::result::Result<(), shipcast::record::Error> {
-    use shipcast::record::{GridRecord, MotionRecord, WavesRecord};
+) -> std::result::Result<(), shipcast::shell::record::Error> {
+    use shipcast::shell::record::{GridRecord, MotionRecord, WavesRecord};
     if radar {
         let field = sim.radar(t);
         if grid_every > 0
@@ -444,10 +448,10 @@ fn record_step(
 }
 
 /// The simulator's newest radar scan on the data clock (`simulate.radar.output = "grid"`).
-fn scan_of(sim: &Simulation, epoch: f64) -> Option<shipcast::ipc::Scan> {
+fn scan_of(sim: &Simulation, epoch: f64) -> Option<shipcast::shell::ipc::Scan> {
     let (mut grid, frame) = sim.last_scan()?;
     grid.time_s += epoch;
-    Some(shipcast::ipc::Scan { grid, frame })
+    Some(shipcast::shell::ipc::Scan { grid, frame })
 }
 
 /// Sets `flag` on SIGINT/SIGTERM (the simulator is not async).
@@ -483,7 +487,7 @@ fn finite(v: f64) -> serde_json::Value {
 /// units (`heave_m`, `roll_deg`, ...) and the displacement of its points of interest (`x_m`, `y_m`,
 /// `z_m`, global axes); non-finite numbers as null.
 pub fn forecast_json(
-    h: &shipcast::ipc::wire::ForecastHeader,
+    h: &shipcast::shell::ipc::wire::ForecastHeader,
     values: &[f64],
     sys: &shipcast::hydro::VesselSystem,
 ) -> String {
@@ -556,7 +560,7 @@ pub fn forecast_json(
         "dt_s": finite(h.dt_s),
         "wave_time_s": finite(h.wave_time_s),
         "compute_ms": finite(h.compute_ms),
-        "received_wall_s": finite(service::wall_s()),
+        "received_wall_s": finite(daemon::wall_s()),
         "vessels": vessels,
         "flags": flags::names(h.flags),
     })
@@ -598,8 +602,8 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
             "pitch_deg": finite(b[2].to_degrees()),
         })).collect::<Vec<_>>(),
         // the ship-to-ship link: null when none runs
-        "link": (s.link_state != shipcast::ipc::wire::link_state::NONE).then(|| serde_json::json!({
-            "up": s.link_state == shipcast::ipc::wire::link_state::UP,
+        "link": (s.link_state != shipcast::shell::ipc::wire::link_state::NONE).then(|| serde_json::json!({
+            "up": s.link_state == shipcast::shell::ipc::wire::link_state::UP,
             "latency_ms": finite(s.link_latency_ms).as_f64().filter(|v| *v >= 0.0),
             "loss": finite(s.link_loss).as_f64().filter(|v| *v >= 0.0),
             "last_message_age_s": finite(s.link_age_s).as_f64().filter(|v| *v >= 0.0),
@@ -623,7 +627,7 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
     ctrlc_flag(stop.clone())?;
     let mut out = std::io::stdout().lock();
     let mut got = vec![];
-    let n_vessels = sys.spec.bodies.len().min(shipcast::ipc::wire::MAX_VESSELS);
+    let n_vessels = sys.spec.bodies.len().min(shipcast::shell::ipc::wire::MAX_VESSELS);
     while !stop.load(std::sync::atomic::Ordering::Relaxed) {
         got.clear();
         sub.wait(Duration::from_millis(500), &mut got)
@@ -631,7 +635,7 @@ pub fn watch(a: &WatchArgs) -> Result<()> {
         for r in &got {
             match r {
                 Received::Forecast(h, v) => {
-                    if h.schema_version != shipcast::ipc::wire::FORECAST_SCHEMA_VERSION {
+                    if h.schema_version != shipcast::shell::ipc::wire::FORECAST_SCHEMA_VERSION {
                         eprintln!("skipping a forecast of schema version {}", h.schema_version);
                         continue;
                     }
@@ -702,7 +706,7 @@ pub struct DemoArgs {
 /// skill so far: the forecasts of 30 s ago against the motion measured now). Ctrl-C (or q in the
 /// console) stops all three.
 pub fn demo(a: &DemoArgs) -> Result<()> {
-    use shipcast::process::Interrupting;
+    use shipcast::shell::process::Interrupting;
     let cfg = load_config(&a.config)?;
     let sys = load_system(&cfg)?;
     let exe = std::env::current_exe()?;
@@ -763,7 +767,7 @@ fn plain_demo(
     seconds: Option<f64>,
     stop: &AtomicBool,
 ) -> Result<()> {
-    use shipcast::ipc::MotionSubscriber;
+    use shipcast::shell::ipc::MotionSubscriber;
     let wanted_s = shipcast::engine::history_wanted_s(cfg, sys);
     let mut first_motion_s: Option<f64> = None;
     let names = Names {

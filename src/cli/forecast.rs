@@ -4,11 +4,11 @@ use super::Radiation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use shipcast::files;
 use shipcast::hydro::VesselSystem;
 use shipcast::rom::outputs::Derived;
 use shipcast::rom::{Forecast, Forecaster, RadiationMethod, TimeModel};
-use shipcast::scenario::{Scenario, past_options, prepare};
+use shipcast::shell::files;
+use shipcast::shell::scenario::{Scenario, past_options, prepare};
 use std::io::Write;
 use std::path::PathBuf;
 

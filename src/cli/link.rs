@@ -1,8 +1,8 @@
-//! `shipcast link`: the ship-to-ship link's process (`shipcast::link`).
+//! `shipcast link`: the ship-to-ship link's process (`shipcast::shell::link`).
 
 use anyhow::Result;
 use clap::Args;
-use shipcast::service::config::ShipcastConfig;
+use shipcast::shell::config::ShipcastConfig;
 
 #[derive(Args, Debug)]
 pub struct LinkArgs {
@@ -15,7 +15,7 @@ pub struct LinkArgs {
 pub fn run(cfg: ShipcastConfig) -> Result<()> {
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     super::daemon::ctrlc_flag(stop.clone())?;
-    shipcast::link::run(&cfg, stop)
+    shipcast::shell::link::run(&cfg, stop)
 }
 
 #[cfg(not(feature = "link"))]

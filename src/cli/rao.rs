@@ -4,10 +4,10 @@
 use super::Radiation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use shipcast::files;
 use shipcast::rao::FrequencySolver;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
 use shipcast::rom::{RomOptions, TimeModel, floor};
+use shipcast::shell::files;
 use std::io::Write;
 use std::path::PathBuf;
 

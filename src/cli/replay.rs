@@ -5,11 +5,11 @@ use super::plot;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::hydro::VesselSystem;
-use shipcast::ipc::{Names, Output, SensorPublisher, spawn_output};
 use shipcast::operation::{Channel, SpanForecast, WindowScore, score_forecast_windows};
-use shipcast::record::{self, ForecastRecord, Record};
-use shipcast::replay;
-use shipcast::service::config::ShipcastConfig;
+use shipcast::shell::config::ShipcastConfig;
+use shipcast::shell::ipc::{Names, Output, SensorPublisher, spawn_output};
+use shipcast::shell::record::{self, ForecastRecord, Record};
+use shipcast::shell::replay;
 use shipcast::skill::{self, SeriesForecast};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -627,7 +627,7 @@ pub struct ImportArgs {
 
 /// `shipcast import`: external CSV recordings written as a log that `shipcast replay` takes.
 pub fn import(a: &ImportArgs) -> Result<()> {
-    use shipcast::replay::import::{ProbeOptions, default_probe_window_s, motion_csv, probe_csv, probe_fields};
+    use shipcast::shell::replay::import::{ProbeOptions, default_probe_window_s, motion_csv, probe_csv, probe_fields};
     let cfg = load_config(&a.config)?;
     let sys = super::daemon::load_system(&cfg)?;
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
@@ -664,7 +664,7 @@ pub fn import(a: &ImportArgs) -> Result<()> {
         let window_s = a.probe_window.unwrap_or_else(|| {
             rec.towards_deg
                 .or(a.towards_deg)
-                .map_or(shipcast::replay::import::MIN_PROBE_WINDOW_S, |towards| {
+                .map_or(shipcast::shell::replay::import::MIN_PROBE_WINDOW_S, |towards| {
                     default_probe_window_s(
                         rec.position_m,
                         towards,

@@ -1,5 +1,5 @@
 //! The messages the engine takes and gives: plain Rust values, `#[repr(C)]` so that the wire
-//! ([`crate::ipc::wire`], the one place that marks them for iceoryx2 and names their stable type names)
+//! ([`crate::shell::ipc::wire`], the one place that marks them for iceoryx2 and names their stable type names)
 //! sends them as they are, and a C, C++ or Python subscriber declares the same layout field by field.
 //!
 //! Conventions: units SI; times are seconds on the sensors' clock (the data clock: UNIX seconds for

@@ -28,7 +28,7 @@ pub use setup::{
 use crate::band;
 use crate::hydro::VesselSystem;
 use crate::rom::TimeModel;
-use crate::service::config::{self, ShipcastConfig};
+use crate::settings::{self, ShipcastConfig};
 use crate::waves::field::WaveField;
 use estimator::Estimator;
 use message::{MAX_VESSELS, flags};
@@ -107,7 +107,7 @@ const ONE_SHOT_FLAGS: u32 = flags::NUMERICAL | flags::CLOCK_STEP | flags::MOTION
 /// The daemon's state and decisions, driven by a clock the caller supplies (seconds: monotonic wall
 /// time live, the log's time in replay): the same code for both.
 pub struct Engine {
-    cfg: config::ForecastConfig,
+    cfg: settings::ForecastConfig,
     /// The model's step, s.
     dt_s: f64,
     origin_m: [f64; 2],

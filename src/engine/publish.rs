@@ -56,7 +56,7 @@ impl Engine {
     }
 
     /// The model's own mean displacement in waves (heave, roll, pitch), from a forecast's settled leads
-    /// (at least [`SETTLED_LEAD_S`]): averaged over [`crate::service::config::EstimatorConfig`]'s
+    /// (at least [`SETTLED_LEAD_S`]): averaged over [`crate::settings::EstimatorConfig`]'s
     /// `bias_time_s`, as the estimator averages the measured motion. Lines and fenders give a moored
     /// vessel a mean heel in waves; the model starts from its own, and its forecast of roll and pitch
     /// is shifted to the measured one ([`MEASURED_MEAN_DOFS`]).

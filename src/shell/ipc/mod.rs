@@ -163,7 +163,7 @@ pub fn decode_waves(h: &WaveHeader, payload: &[f64]) -> std::result::Result<Wave
             h.schema_version
         ));
     }
-    crate::ipc::wire::check_wave_components(h.n_components as usize)?;
+    crate::shell::ipc::wire::check_wave_components(h.n_components as usize)?;
     let (n, sectors) = (h.n_components as usize, h.n_sectors as usize);
     if sectors > crate::waves::field::MAX_GIVEN_SECTORS {
         return Err(format!(
@@ -849,7 +849,7 @@ mod tests {
         assert_eq!(back.grid.x_m, s.grid.x_m);
         assert!((back.frame.orientation_rad - 0.3).abs() < 1e-12);
         assert!(back.grid.values[7].is_nan() && (back.grid.values[8] - 0.8).abs() < 1e-6);
-        let rec = crate::record::GridRecord::of_scan(&s).scan().unwrap();
+        let rec = crate::shell::record::GridRecord::of_scan(&s).scan().unwrap();
         assert!((rec.frame.origin_m[0] - 100.0).abs() < 1e-9 && (rec.frame.origin_m[1] + 40.0).abs() < 1e-9);
         assert!((rec.frame.orientation_rad - 0.3).abs() < 1e-12);
         assert_eq!(rec.grid.y_m, s.grid.y_m);
@@ -881,7 +881,7 @@ mod tests {
         let (h, v) = encode_waves(&f);
         assert_eq!((h.n_components, h.n_sectors, v.len()), (1, 72, 4 + 72));
         assert_eq!(decode_waves(&h, &v).unwrap(), f);
-        assert_eq!(crate::record::WavesRecord::of(&f).field().unwrap(), f);
+        assert_eq!(crate::shell::record::WavesRecord::of(&f).field().unwrap(), f);
         // a field without a coverage sends none
         let disc = WaveField {
             region: crate::waves::field::Region::Disc {

@@ -2,10 +2,10 @@
 
 use super::HEALTH_PERIOD_S;
 use super::health::Health;
-use crate::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, Status};
-use crate::ipc::{LinkPublisher, Local, LocalSubscriber, Names, Output, OutputPublisher, SensorPublisher};
-use crate::service::config::ShipcastConfig;
-use crate::service::wall_s;
+use crate::shell::config::ShipcastConfig;
+use crate::shell::daemon::wall_s;
+use crate::shell::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, Status};
+use crate::shell::ipc::{LinkPublisher, Local, LocalSubscriber, Names, Output, OutputPublisher, SensorPublisher};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
@@ -188,7 +188,7 @@ fn receive_loop(
     stop: &AtomicBool,
     sent: &AtomicU64,
 ) -> anyhow::Result<()> {
-    let iox = |e: crate::ipc::Error| anyhow::anyhow!("iceoryx2: {e}");
+    let iox = |e: crate::shell::ipc::Error| anyhow::anyhow!("iceoryx2: {e}");
     let sensors = SensorPublisher::new(own).map_err(iox)?;
     let outputs = OutputPublisher::new(peer).map_err(iox)?;
     let health_out = LinkPublisher::new(own).map_err(iox)?;

@@ -6,7 +6,6 @@
 //! Shell-side library module: it reads no file (the caller loads the system) and times only the
 //! state-space fit, for the report.
 
-use crate::files::Loaded;
 use crate::hydro::external::ConnectionKind;
 use crate::hydro::system::{AInfSource, Passivity, TailChoice};
 use crate::hydro::{Dof, VesselSystem, mode_label};
@@ -16,6 +15,7 @@ use crate::radiation::memory;
 use crate::radiation::statespace::ModalModel;
 use crate::rao::FrequencySolver;
 use crate::rom::{RadiationMethod, RomOptions, TimeModel, floor};
+use crate::shell::files::Loaded;
 use std::f64::consts::PI;
 use std::fmt;
 use std::path::Path;

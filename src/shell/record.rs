@@ -1,5 +1,5 @@
 //! Recorded logs (shell): MCAP files of JSON messages, their record types, the recorder and the reader.
-//! The daemon ([`crate::service`]) records with it; [`crate::replay`] reads logs back and feeds them
+//! The daemon ([`crate::shell::daemon`]) records with it; [`crate::shell::replay`] reads logs back and feeds them
 //! through the daemon's engine.
 //!
 //! Why MCAP: chunked, indexed, compressed (zstd), self-describing (each channel names its schema), with
@@ -42,7 +42,7 @@
 //! Version 1 logs (before JSON Schemas, metadata and `/radar`; the simulator's log times from 0) are
 //! read as they are.
 
-use crate::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
+use crate::shell::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
 use crate::waves::field::{FlatHeader, WaveField, coverage_from_sectors};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -489,7 +489,7 @@ const FOXGLOVE_FLOAT32: u32 = 7;
 
 impl GridRecord {
     /// A radar scan (its grid's corner and turn in `pose`; NaN cells kept).
-    pub fn of_scan(scan: &crate::ipc::Scan) -> GridRecord {
+    pub fn of_scan(scan: &crate::shell::ipc::Scan) -> GridRecord {
         let g = &scan.grid;
         let local: Vec<f64> = g.x_m.iter().map(|x| x - g.x_m[0]).collect();
         let mut r = GridRecord::elevation(
@@ -520,7 +520,7 @@ impl GridRecord {
 
     /// The scan of a `/elevation` record (the inverse of [`Self::of_scan`]): one FLOAT32 field, a turn
     /// about z only.
-    pub fn scan(&self) -> Result<crate::ipc::Scan, String> {
+    pub fn scan(&self) -> Result<crate::shell::ipc::Scan, String> {
         use base64::Engine;
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(&self.data)
@@ -543,7 +543,7 @@ impl GridRecord {
             orientation_rad: theta,
         };
         let origin = frame.to_earth(0.5 * dx, 0.5 * dy);
-        Ok(crate::ipc::Scan {
+        Ok(crate::shell::ipc::Scan {
             grid: crate::waves::observe::Grid {
                 x_m: (0..nx).map(|i| i as f64 * dx).collect(),
                 y_m: (0..ny).map(|i| i as f64 * dy).collect(),

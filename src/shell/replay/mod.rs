@@ -1,10 +1,12 @@
-//! Replay (shell): a recorded log ([`crate::record`]) fed through the daemon's own engine on the log's
+//! Replay (shell): a recorded log ([`crate::shell::record`]) fed through the daemon's own engine on the log's
 //! clock ([`drive`]), and external CSV recordings turned into records ([`import`]).
 //!
-//! The log's records and reader are [`crate::record`]'s; the ones replay's callers use with [`drive`] are
+//! The log's records and reader are [`crate::shell::record`]'s; the ones replay's callers use with [`drive`] are
 //! re-exported here.
 
-pub use crate::record::{Error, ForecastRecord, MotionRecord, NavigationRecord, Read, Record, WavesRecord, read};
+pub use crate::shell::record::{
+    Error, ForecastRecord, MotionRecord, NavigationRecord, Read, Record, WavesRecord, read,
+};
 
 pub mod import;
 
@@ -15,14 +17,14 @@ pub mod import;
 /// `on_output` sees every forecast and every tick's status; `pace` is called with each tick's log time
 /// (the shell sleeps there for `--speed`, and publishes the inputs up to it).
 pub fn drive(
-    cfg: &crate::service::config::ShipcastConfig,
+    cfg: &crate::shell::config::ShipcastConfig,
     sys: &crate::hydro::VesselSystem,
     records: &[(f64, Record)],
     mut pace: impl FnMut(f64),
-    mut on_output: impl FnMut(crate::ipc::Output),
+    mut on_output: impl FnMut(crate::shell::ipc::Output),
 ) -> Result<crate::engine::Counters, Error> {
     use crate::engine::{Computer, Engine, rom_options};
-    use crate::ipc::{Input, Output};
+    use crate::shell::ipc::{Input, Output};
     crate::engine::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);

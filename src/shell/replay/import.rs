@@ -19,7 +19,7 @@
 //!   field is fitted to the last `window_s` of the record ([`crate::waves::observe::from_probe`]).
 
 use crate::hydro::Dof;
-use crate::record::{MotionRecord, WavesRecord};
+use crate::shell::record::{MotionRecord, WavesRecord};
 use crate::waves::field::heading_from_compass_deg;
 use crate::waves::observe::from_probe;
 

@@ -6,7 +6,7 @@
 //! receipt's wall clock less the sender's stamp (both hosts' clocks: GNSS-disciplined on a ship,
 //! exact on one host). Times in s.
 
-use crate::ipc::wire::{LINK_SCHEMA_VERSION, LinkStatus};
+use crate::shell::ipc::wire::{LINK_SCHEMA_VERSION, LinkStatus};
 use std::collections::{BTreeMap, VecDeque};
 
 /// What happened to one message, over the window.

@@ -6,19 +6,17 @@
 //! from a log's clock: one code path.
 //!
 //! Threads: the tokio runtime owns the engine and the cadence; the iceoryx2 input and output threads
-//! ([`crate::ipc`]) bridge to it with channels; the forecast itself runs on a compute thread of its own
+//! ([`crate::shell::ipc`]) bridge to it with channels; the forecast itself runs on a compute thread of its own
 //! so a slow forecast never blocks the ports. A forecast that is still running when the next tick
 //! comes is counted as an overrun and that tick is skipped (no pile-up). Every tick publishes a status;
 //! a forecast is published only when the inputs allow one (see [`crate::engine::message::flags`]).
 
-pub mod config;
-
 use crate::engine::{Computer, Done, Engine, Job, describe_step, fits_the_wire, rom_options, watchdog_fits};
 use crate::hydro::VesselSystem;
-use crate::ipc::wire::{MotionSample, SCHEMA_VERSION};
-use crate::ipc::{self, Input, Names, Output};
 use crate::rom::TimeModel;
-use config::ShipcastConfig;
+use crate::shell::config::ShipcastConfig;
+use crate::shell::ipc::wire::{MotionSample, SCHEMA_VERSION};
+use crate::shell::ipc::{self, Input, Names, Output};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -77,16 +75,16 @@ fn build(cfg: &ShipcastConfig, sys: &VesselSystem) -> Result<(TimeModel, Engine)
 }
 
 /// The daemon's recorder (`[record]`), or None when it records nothing or cannot (logged).
-fn open_recorder(cfg: &ShipcastConfig, sys: &VesselSystem) -> Option<crate::record::RotatingRecorder> {
+fn open_recorder(cfg: &ShipcastConfig, sys: &VesselSystem) -> Option<crate::shell::record::RotatingRecorder> {
     if cfg.record.dir.is_empty() {
         return None;
     }
     let dir = cfg.dir.join(&cfg.record.dir);
-    match crate::record::RotatingRecorder::new(
+    match crate::shell::record::RotatingRecorder::new(
         &dir,
         cfg.record.rotate_mb,
         cfg.record.rotate_s,
-        crate::record::LogInfo::of(cfg, &cfg.system.file, sys, "daemon"),
+        crate::shell::record::LogInfo::of(cfg, &cfg.system.file, sys, "daemon"),
     ) {
         Ok(r) => Some(r),
         Err(e) => {
@@ -97,7 +95,7 @@ fn open_recorder(cfg: &ShipcastConfig, sys: &VesselSystem) -> Option<crate::reco
 }
 
 /// One record into the recording; a write error ends the recording (logged), never the daemon.
-fn record(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, r: crate::record::Record) {
+fn record(recorder: &mut Option<crate::shell::record::RotatingRecorder>, t: f64, r: crate::shell::record::Record) {
     if let Some(rec) = recorder.as_mut()
         && let Err(e) = rec.record(t, &r)
     {
@@ -107,8 +105,8 @@ fn record(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, r: cra
 }
 
 /// An input as it arrived, into the recording.
-fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, msg: &Input) {
-    use crate::record::{MotionRecord, Record, WavesRecord};
+fn record_input(recorder: &mut Option<crate::shell::record::RotatingRecorder>, t: f64, msg: &Input) {
+    use crate::shell::record::{MotionRecord, Record, WavesRecord};
     if recorder.is_none() {
         return;
     }
@@ -124,11 +122,15 @@ fn record_input(recorder: &mut Option<crate::record::RotatingRecorder>, t: f64, 
             }),
         ),
         Input::Waves(f) => record(recorder, t, Record::Waves(WavesRecord::of(f))),
-        Input::Navigation(n) => record(recorder, t, Record::Navigation(crate::record::NavigationRecord::of(n))),
+        Input::Navigation(n) => record(
+            recorder,
+            t,
+            Record::Navigation(crate::shell::record::NavigationRecord::of(n)),
+        ),
         Input::Elevation(scan) => record(
             recorder,
             t,
-            Record::Elevation(Box::new(crate::record::GridRecord::of_scan(scan))),
+            Record::Elevation(Box::new(crate::shell::record::GridRecord::of_scan(scan))),
         ),
         // the link's health changes no forecast
         Input::Rejected(_) | Input::Link(_) => {}
@@ -240,7 +242,7 @@ pub async fn run(
                 };
                 if let Some(out) = engine.done(d) {
                     if let Output::Forecast(h, v) = &out {
-                        let rec = crate::record::Record::Forecast(crate::record::ForecastRecord::of(h, v));
+                        let rec = crate::shell::record::Record::Forecast(crate::shell::record::ForecastRecord::of(h, v));
                         record(&mut recorder, clock(), rec);
                     }
                     let _ = th.out_tx.send(out);
@@ -256,7 +258,7 @@ pub async fn run(
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
                 let t = clock();
-                record(&mut recorder, t, crate::record::Record::Tick(crate::record::TickRecord { clock_s: t }));
+                record(&mut recorder, t, crate::shell::record::Record::Tick(crate::shell::record::TickRecord { clock_s: t }));
                 if let Some(job) = engine.tick(t) {
                     let _ = th.job_tx.send(job);
                 }
@@ -274,7 +276,7 @@ pub async fn run(
 }
 
 /// A clean shutdown after the last status: the recording closed, systemd told, the threads joined.
-fn finish(th: Threads, recorder: Option<crate::record::RotatingRecorder>, engine: &Engine) {
+fn finish(th: Threads, recorder: Option<crate::shell::record::RotatingRecorder>, engine: &Engine) {
     drop(th.out_tx);
     drop(th.job_tx);
     drop(th.in_rx);
