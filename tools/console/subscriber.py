@@ -2,7 +2,7 @@
 """A shipcast forecast subscriber in Python: the reference for console writers in other languages.
 
 Reads the daemon's `<prefix>/forecast` service over iceoryx2 (pip package `iceoryx2`, the same version
-as the crate: see requirements.txt) and decodes the payload documented in src/ipc/wire.rs:
+as the crate: see requirements.txt) and decodes the payload documented in src/engine/message.rs:
 a ForecastHeader user header and a slice of f64, series-major, series s = 6 v + d (vessel v, DOF d in
 surge, sway, heave, roll, pitch, yaw), steps + 1 displacements each at issue_time_s + k dt_s, then
 as many standard deviations (the forecast's band) in the same order.

@@ -54,7 +54,7 @@ RAO convention, confirmed (not assumed) before relying on it:
   origin = Re{-i a k e^(i w t)}). All as response = Re{ amplitude exp(i phase) a exp(i w t) } for the wave
   Re{ a exp(i w t) } at the origin, with heading 180 travelling to -x.
 
-Outputs, in --out (layouts of src/replay/import.rs, top comment):
+Outputs, in --out (layouts of src/shell/replay/import.rs, top comment):
   motion.csv  time_s,vessel,surge_m,sway_m,heave_m,roll_deg,pitch_deg,yaw_deg  at 5 Hz, 0..1500 s,
               vessel `barge`, with sensor noise: heave white 0.01 m std, roll and pitch white 0.05 deg std
               (surge, sway and yaw noise-free)
@@ -185,7 +185,7 @@ shipcast's time-domain model: a frequency-domain linear superposition of Capytai
 - `motion.csv` (5 Hz, 0-{args.duration:g} s, vessel `barge`): the six motions with white sensor noise (heave 0.01 m,
   roll and pitch 0.05 deg std; surge, sway and yaw noise-free). `truth.csv`: the same without noise.
 - `probe.csv` (2 Hz): the elevation at the probe with 0.02 m white noise; `towards_deg` 270.
-- Layouts: `src/replay/import.rs` (top comment); system `config/vessels/barge/system.toml`.
+- Layouts: `src/shell/replay/import.rs` (top comment); system `config/vessels/barge/system.toml`.
 """)
 
 
