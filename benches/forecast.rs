@@ -2,7 +2,7 @@
 //! every DOF active), both radiation methods, 240 wave components in a short-crested JONSWAP sea
 //! (config/scenarios/two-ship.toml's sea), after a 600 s simulated history; and one integrator step.
 //! The two-ship state-space forecast also underway: 3 m/s and turning at 0.2 deg/s from t0 (the wave
-//! force in pieces of 2 deg of heading). The band of the two-ship forecast (`rom::spread`: every
+//! force in pieces of 2 deg of heading). The band of the two-ship forecast (`band`: every
 //! component's response variance and the leads it is known over, as the daemon adds it to each
 //! forecast), against the forecast it goes with. Setup (loading, fitting, the spin-up, the response
 //! table) is outside the timing.

@@ -88,14 +88,14 @@ fn init_logging(level: &str, json: bool) {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run(a) => match cli::daemon::load_config(&a.config) {
+        Command::Run(a) => match cli::load_config(&a.config) {
             Ok(cfg) => {
                 init_logging(&cfg.log.level, cfg.log.format == "json");
                 Some(cli::daemon::run(cfg))
             }
             Err(e) => Some(Err(e)),
         },
-        Command::Link(a) => match cli::daemon::load_config(&a.config) {
+        Command::Link(a) => match cli::load_config(&a.config) {
             Ok(cfg) => {
                 init_logging(&cfg.log.level, cfg.log.format == "json");
                 Some(cli::link::run(cfg))

@@ -133,7 +133,7 @@ pub struct ForecastConfig {
     /// Radar scans (`<prefix>/elevation`) of one grid inverted together into a field.
     pub radar_snapshots: u32,
     /// The model's error, as a fraction of each motion's standard deviation, until the daemon has
-    /// learnt it from its own forecasts (`rom::spread::ModelError`): the floor of the forecast's band,
+    /// learnt it from its own forecasts (`band::ModelError`): the floor of the forecast's band,
     /// growing in proportion to the lead beyond 30 s.
     pub model_error: f64,
     /// A lead is trusted while the forecast's expected normalized RMS error (its band's standard
@@ -199,7 +199,7 @@ pub struct EstimatorConfig {
     /// The motion sensor's drift: a bias that wanders (first-order Gauss-Markov), its standard
     /// deviation (translations m, rotations rad) and correlation time, s. What the bias average leaves
     /// of it widens the band at a forecast's start; what the average holds is how large a roll or
-    /// pitch offset the sensor's bias may make (`rom::spread::heel_split`).
+    /// pitch offset the sensor's bias may make (`band::heel_split`).
     pub drift_m: f64,
     pub drift_rad: f64,
     pub drift_time_s: f64,

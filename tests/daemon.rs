@@ -712,3 +712,60 @@ fn a_panic_in_the_compute_thread_ends_the_daemon_with_an_error() {
         t.elapsed().as_secs_f64()
     );
 }
+
+/// The daemon's loop runs in-process (as mini-redis's server does): given its shutdown as a future,
+/// it publishes status while running and, once that future resolves, a last status with `running` 0,
+/// and returns without an error.
+#[test]
+fn the_daemon_loop_runs_in_process_and_stops_on_its_shutdown_future() {
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+    let dir = crate::util::scratch_dir("in-process");
+    let path = config(&dir, "in-process", "");
+    let cfg = shipcast::shell::config::load(&path).unwrap();
+    let sys = shipcast::shell::files::load_system(&cfg.dir.join(&cfg.system.file))
+        .unwrap()
+        .system;
+    let sub = ForecastSubscriber::new(&Names {
+        prefix: cfg.ipc.service_prefix.clone(),
+    })
+    .unwrap();
+    let (shutdown_tx, shutdown_rx) = tokio::sync::oneshot::channel::<()>();
+    let daemon = std::thread::spawn(move || {
+        let rt = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()
+            .unwrap();
+        let shutdown = async {
+            let _ = shutdown_rx.await;
+        };
+        rt.block_on(shipcast::shell::daemon::run(
+            cfg,
+            sys,
+            Arc::new(AtomicBool::new(false)),
+            shutdown,
+        ))
+        .map_err(|e| e.to_string())
+    });
+    let mut got = vec![];
+    let statuses = |got: &[Received], running: u32| {
+        got.iter()
+            .filter(|r| matches!(r, Received::Status(s) if s.running == running))
+            .count()
+    };
+    let t = Instant::now();
+    while statuses(&got, 1) < 2 && t.elapsed() < Duration::from_secs(30) {
+        sub.wait(Duration::from_millis(500), &mut got).unwrap();
+    }
+    assert!(statuses(&got, 1) >= 2, "no status from the running daemon: {got:?}");
+    shutdown_tx.send(()).unwrap();
+    assert_eq!(daemon.join().unwrap(), Ok(()));
+    let t = Instant::now();
+    while statuses(&got, 0) == 0 && t.elapsed() < Duration::from_secs(5) {
+        sub.wait(Duration::from_millis(200), &mut got).unwrap();
+    }
+    assert_eq!(statuses(&got, 0), 1, "the last status says the daemon stopped");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -58,7 +58,7 @@ fn a_following_sea_met_at_zero_encounter_frequency_gives_a_finite_forecast_and_i
     assert_eq!(f.skipped_components, 0);
     // the zero-frequency component's force alone is the constant Re{X a}
     let z = vec![0.0; model.n()];
-    let mem = shipcast::rom::Memory::new(model);
+    let mem = shipcast::radiation::history::Memory::new(model);
     let req = shipcast::rom::ForecastRequest {
         x0: &z,
         v0: &z,
@@ -139,7 +139,7 @@ fn turning_force_errors(piece_rad: f64) -> Vec<f64> {
         ..Track::straight(3.0)
     };
     let z = vec![0.0; model.n()];
-    let mem = shipcast::rom::Memory::new(model);
+    let mem = shipcast::radiation::history::Memory::new(model);
     let req = shipcast::rom::ForecastRequest {
         x0: &z,
         v0: &z,

@@ -9,7 +9,8 @@
 use crate::util::repo;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use shipcast::rom::{ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use shipcast::radiation::history::Memory;
+use shipcast::rom::{ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
 use shipcast::shell::files::load_system;
 use shipcast::waves::WaveComponent;
 

@@ -128,8 +128,8 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
 }
 
 pub fn run(a: &ConsoleArgs) -> Result<()> {
-    let cfg = super::daemon::load_config(&a.config)?;
-    let sys = super::daemon::load_system(&cfg)?;
+    let cfg = super::load_config(&a.config)?;
+    let sys = super::load_system(&cfg)?;
     view(&cfg, &sys, a.prefix.clone(), a.seconds)
 }
 

@@ -1,10 +1,11 @@
 //! `shipcast run`, `simulate`, `watch` and `demo`: the daemon and its companions (wiring only).
 
+use super::{load_config, load_system};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shipcast::engine::vessel_positions;
 use shipcast::hydro::{Dof, VesselSystem};
-use shipcast::shell::config::{self, ShipcastConfig};
+use shipcast::shell::config::ShipcastConfig;
 use shipcast::shell::daemon::{self, to_wire};
 use shipcast::shell::files;
 use shipcast::shell::ipc::wire::{Status, flags};
@@ -59,29 +60,6 @@ pub struct WatchArgs {
     /// Give up after this many seconds without a forecast (default: wait for ever).
     #[arg(long, allow_negative_numbers = true)]
     timeout: Option<f64>,
-}
-
-pub fn load_config(arg: &super::ConfigArg) -> Result<ShipcastConfig> {
-    let path = arg.path();
-    if !path.exists() {
-        bail!(
-            "{}: no such configuration file (give --config FILE or set SHIPCAST_CONFIG; without them shipcast looks for {})",
-            path.display(),
-            super::CONFIG_SEARCH.join(" and ")
-        );
-    }
-    Ok(config::load(&path)?)
-}
-
-pub fn system_path(cfg: &ShipcastConfig) -> PathBuf {
-    cfg.dir.join(&cfg.system.file)
-}
-
-/// The config's vessel system; an error names the config file and its `[system] file` key.
-pub fn load_system(cfg: &ShipcastConfig) -> Result<shipcast::hydro::VesselSystem> {
-    files::load_system(&system_path(cfg))
-        .map(|l| l.system)
-        .with_context(|| format!("{}: [system] file = {:?}", cfg.path.display(), cfg.system.file))
 }
 
 pub fn run(cfg: ShipcastConfig) -> Result<()> {
@@ -167,14 +145,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         bail!("--duration {duration}: must be positive");
     }
     let t = Instant::now();
-    let truth = match &cfg.simulate.truth_system {
-        Some(file) => Some(
-            files::load_system(&cfg.dir.join(file))
-                .map(|l| l.system)
-                .with_context(|| format!("{}: [simulate] truth_system = {file:?}", cfg.path.display()))?,
-        ),
-        None => None,
-    };
+    let truth = truth_system(&cfg)?;
     let mut sim = Simulation::new(
         &sys,
         truth.as_ref(),
@@ -220,27 +191,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         if let Some(p) = &out.publisher {
             wait_until(t);
             if next_radar <= next_imu {
-                let field = sim.radar(t);
-                if grid_output {
-                    if let Some(scan) = scan_of(&sim, epoch) {
-                        p.elevation(&scan)
-                            .map_err(|e| anyhow::anyhow!("publishing elevation: {e}"))?;
-                    }
-                } else if let Some(mut f) = field {
-                    f.time_s += epoch;
-                    p.waves(&f).map_err(|e| anyhow::anyhow!("publishing waves: {e}"))?;
-                }
+                publish_radar(p, &mut sim, t, epoch, grid_output)?;
                 next_radar += radar_dt;
                 continue;
             }
-            for mut s in sim.imu(t) {
-                s.time_s += epoch;
-                let m = to_wire(&s);
-                out.publisher_of(m.vessel)
-                    .unwrap_or(p)
-                    .motion(&m)
-                    .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
-            }
+            publish_imu(&out, p, &mut sim, t, epoch)?;
         } else if let Some(rec) = out.recorder.as_mut() {
             let radar = next_radar <= next_imu;
             let at = a.record.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
@@ -259,6 +214,49 @@ pub fn simulate(a: &SimulateArgs) -> Result<()> {
         stop_seen = stop.load(std::sync::atomic::Ordering::Relaxed);
     }
     out.finish(duration, t)
+}
+
+/// The system the true motion is computed with when it is not the forecaster's
+/// (`[simulate] truth_system`); an error names the config file and the key.
+fn truth_system(cfg: &ShipcastConfig) -> Result<Option<VesselSystem>> {
+    Ok(match &cfg.simulate.truth_system {
+        Some(file) => Some(
+            files::load_system(&cfg.dir.join(file))
+                .map(|l| l.system)
+                .with_context(|| format!("{}: [simulate] truth_system = {file:?}", cfg.path.display()))?,
+        ),
+        None => None,
+    })
+}
+
+/// Publishes the radar scan at `t` (data clock `t + epoch`): its elevation grid with `grid_output`,
+/// else its wave field.
+fn publish_radar(p: &SensorPublisher, sim: &mut Simulation, t: f64, epoch: f64, grid_output: bool) -> Result<()> {
+    let field = sim.radar(t);
+    if grid_output {
+        if let Some(scan) = scan_of(sim, epoch) {
+            p.elevation(&scan)
+                .map_err(|e| anyhow::anyhow!("publishing elevation: {e}"))?;
+        }
+    } else if let Some(mut f) = field {
+        f.time_s += epoch;
+        p.waves(&f).map_err(|e| anyhow::anyhow!("publishing waves: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Publishes the IMU samples at `t` (data clock `t + epoch`), each through its vessel's publisher,
+/// else `p`.
+fn publish_imu(out: &SimOutputs, p: &SensorPublisher, sim: &mut Simulation, t: f64, epoch: f64) -> Result<()> {
+    for mut s in sim.imu(t) {
+        s.time_s += epoch;
+        let m = to_wire(&s);
+        out.publisher_of(m.vessel)
+            .unwrap_or(p)
+            .motion(&m)
+            .map_err(|e| anyhow::anyhow!("publishing motion: {e}"))?;
+    }
+    Ok(())
 }
 
 /// Where `simulate` sends what it makes: iceoryx2 publishers (one per `--vessel-prefix`, the default
@@ -768,17 +766,19 @@ fn plain_demo(
     stop: &AtomicBool,
 ) -> Result<()> {
     use shipcast::shell::ipc::MotionSubscriber;
-    let wanted_s = shipcast::engine::history_wanted_s(cfg, sys);
-    let mut first_motion_s: Option<f64> = None;
+    let mut demo = DemoSkill {
+        wanted_s: shipcast::engine::history_wanted_s(cfg, sys),
+        first_motion_s: None,
+        pending: vec![],
+        measured: Default::default(),
+        pairs_f: vec![],
+        pairs_m: vec![],
+    };
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
     };
     let sub = ForecastSubscriber::new(&names).map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
     let motion = MotionSubscriber::new(&names).map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
-    const LEAD: f64 = 30.0;
-    let mut pending: Vec<(f64, f64)> = vec![]; // (valid time, forecast heave of vessel 0)
-    let mut measured: std::collections::VecDeque<(f64, f64)> = Default::default();
-    let (mut pairs_f, mut pairs_m) = (vec![], vec![]);
     let mut got = vec![];
     let mut samples = vec![];
     let start = Instant::now();
@@ -795,14 +795,49 @@ fn plain_demo(
             .drain(&mut samples)
             .map_err(|e| anyhow::anyhow!("iceoryx2: {e}"))?;
         for s in samples.iter().filter(|s| s.vessel == 0) {
-            measured.push_back((s.time_s, s.x[2]));
-            first_motion_s.get_or_insert(s.time_s);
+            demo.measured.push_back((s.time_s, s.x[2]));
+            demo.first_motion_s.get_or_insert(s.time_s);
         }
-        while measured.len() > 5000 {
-            measured.pop_front();
+        while demo.measured.len() > 5000 {
+            demo.measured.pop_front();
         }
-        // score the forecasts whose valid time has been measured
-        pending.retain(|(t, f)| {
+        demo.score_pending();
+        for r in &got {
+            if let Received::Forecast(h, v) = r {
+                demo.on_forecast(h, v, &name0);
+            }
+        }
+    }
+    println!("shipcast demo: stopping");
+    Ok(())
+}
+
+/// The lead `plain_demo` scores the forecasts at, s.
+const DEMO_LEAD_S: f64 = 30.0;
+
+/// What `plain_demo` keeps: the first vessel's measured heave, the forecasts of it waiting for their
+/// valid time, and the (forecast, measured) pairs scored so far.
+struct DemoSkill {
+    /// The motion memory the daemon wants, s.
+    wanted_s: f64,
+    /// The first measured time, s.
+    first_motion_s: Option<f64>,
+    /// (valid time, forecast heave of vessel 0)
+    pending: Vec<(f64, f64)>,
+    /// (time, measured heave of vessel 0), the newest 5000.
+    measured: std::collections::VecDeque<(f64, f64)>,
+    /// Forecast heave of the scored pairs, m.
+    pairs_f: Vec<f64>,
+    /// Measured heave of the scored pairs, m.
+    pairs_m: Vec<f64>,
+}
+
+impl DemoSkill {
+    /// Scores the pending forecasts whose valid time has been measured (the measured heave
+    /// interpolated to it) and drops them.
+    fn score_pending(&mut self) {
+        let (measured, pairs_f, pairs_m) = (&self.measured, &mut self.pairs_f, &mut self.pairs_m);
+        self.pending.retain(|(t, f)| {
             let Some(i) = measured.iter().position(|(tm, _)| *tm >= *t) else {
                 return true;
             };
@@ -815,51 +850,63 @@ fn plain_demo(
             }
             false
         });
-        for r in &got {
-            if let Received::Forecast(h, v) = r {
-                let n = h.steps as usize + 1;
-                let k = (LEAD / h.dt_s).round() as usize;
-                let heave = &v[2 * n..3 * n];
-                if k < n {
-                    pending.push((h.issue_time_s + LEAD, heave[k]));
-                }
-                let skill = if pairs_f.len() >= 10 {
-                    format!(
-                        "skill at {LEAD:.0} s so far: correlation {:.3} over {} forecasts",
-                        shipcast::skill::correlation(&pairs_f, &pairs_m),
-                        pairs_f.len()
-                    )
-                } else {
-                    format!(
-                        "skill at {LEAD:.0} s: waiting for the measured motion ({} scored)",
-                        pairs_f.len()
-                    )
-                };
-                let mut fl = if h.flags != 0 {
-                    format!(" [{}]", flags::names(h.flags).join(", "))
-                } else {
-                    String::new()
-                };
-                if h.flags & flags::HISTORY_SHORT != 0
-                    && let (Some(first), Some((last, _))) = (first_motion_s, measured.back())
-                {
-                    let left = wanted_s - (last - first);
-                    if left > 0.0 {
-                        fl.push_str(&format!(
-                            " warming up: the {wanted_s:.0} s motion memory fills in {left:.0} s more (forecasts less sure until then)"
-                        ));
-                    }
-                }
-                println!(
-                    "{name0} heave now {:+.2} m, in {LEAD:.0} s {:+.2} m, horizon {:.0} s, computed in {:.0} ms; {skill}{fl}",
-                    heave[0],
-                    heave[k.min(n - 1)],
-                    h.horizon_s[0],
-                    h.compute_ms
-                );
-            }
+    }
+
+    /// Queues the forecast's heave at [`DEMO_LEAD_S`] for scoring and prints its line: heave now and
+    /// at the lead, horizon, compute time, skill so far, flags.
+    fn on_forecast(&mut self, h: &shipcast::shell::ipc::wire::ForecastHeader, v: &[f64], name0: &str) {
+        let n = h.steps as usize + 1;
+        let k = (DEMO_LEAD_S / h.dt_s).round() as usize;
+        let heave = &v[2 * n..3 * n];
+        if k < n {
+            self.pending.push((h.issue_time_s + DEMO_LEAD_S, heave[k]));
+        }
+        let skill = self.skill_words();
+        let fl = self.flag_words(h.flags);
+        println!(
+            "{name0} heave now {:+.2} m, in {DEMO_LEAD_S:.0} s {:+.2} m, horizon {:.0} s, computed in {:.0} ms; {skill}{fl}",
+            heave[0],
+            heave[k.min(n - 1)],
+            h.horizon_s[0],
+            h.compute_ms
+        );
+    }
+
+    /// The correlation at the lead so far (from 10 pairs), or how many pairs are scored yet.
+    fn skill_words(&self) -> String {
+        if self.pairs_f.len() >= 10 {
+            format!(
+                "skill at {DEMO_LEAD_S:.0} s so far: correlation {:.3} over {} forecasts",
+                shipcast::skill::correlation(&self.pairs_f, &self.pairs_m),
+                self.pairs_f.len()
+            )
+        } else {
+            format!(
+                "skill at {DEMO_LEAD_S:.0} s: waiting for the measured motion ({} scored)",
+                self.pairs_f.len()
+            )
         }
     }
-    println!("shipcast demo: stopping");
-    Ok(())
+
+    /// The forecast's flags in brackets (empty without), and while the motion memory fills, how long
+    /// until it is full.
+    fn flag_words(&self, forecast_flags: u32) -> String {
+        let wanted_s = self.wanted_s;
+        let mut fl = if forecast_flags != 0 {
+            format!(" [{}]", flags::names(forecast_flags).join(", "))
+        } else {
+            String::new()
+        };
+        if forecast_flags & flags::HISTORY_SHORT != 0
+            && let (Some(first), Some((last, _))) = (self.first_motion_s, self.measured.back())
+        {
+            let left = wanted_s - (last - first);
+            if left > 0.0 {
+                fl.push_str(&format!(
+                    " warming up: the {wanted_s:.0} s motion memory fills in {left:.0} s more (forecasts less sure until then)"
+                ));
+            }
+        }
+        fl
+    }
 }

@@ -10,6 +10,8 @@ pub mod plot;
 pub mod rao;
 pub mod replay;
 
+use anyhow::{Context, Result, bail};
+use shipcast::settings::ShipcastConfig;
 use std::path::PathBuf;
 
 /// `--config FILE`, shared by every subcommand that reads the daemon's configuration.
@@ -80,6 +82,31 @@ impl From<Radiation> for shipcast::rom::RadiationMethod {
             Radiation::StateSpace => RadiationMethod::StateSpace,
         }
     }
+}
+
+/// The configuration `--config` names (or the default one), loaded.
+pub fn load_config(arg: &ConfigArg) -> Result<ShipcastConfig> {
+    let path = arg.path();
+    if !path.exists() {
+        bail!(
+            "{}: no such configuration file (give --config FILE or set SHIPCAST_CONFIG; without them shipcast looks for {})",
+            path.display(),
+            CONFIG_SEARCH.join(" and ")
+        );
+    }
+    Ok(shipcast::shell::config::load(&path)?)
+}
+
+/// The system file a configuration names.
+pub fn system_path(cfg: &ShipcastConfig) -> PathBuf {
+    cfg.dir.join(&cfg.system.file)
+}
+
+/// The config's vessel system; an error names the config file and its `[system] file` key.
+pub fn load_system(cfg: &ShipcastConfig) -> Result<shipcast::hydro::VesselSystem> {
+    shipcast::shell::files::load_system(&system_path(cfg))
+        .map(|l| l.system)
+        .with_context(|| format!("{}: [system] file = {:?}", cfg.path.display(), cfg.system.file))
 }
 
 #[cfg(test)]

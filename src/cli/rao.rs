@@ -4,6 +4,7 @@
 use super::Radiation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use shipcast::hydro::VesselSystem;
 use shipcast::rao::FrequencySolver;
 use shipcast::rom::regular::{RegularOptions, time_domain_rao};
 use shipcast::rom::{RomOptions, TimeModel, floor};
@@ -110,27 +111,8 @@ pub fn run(args: &RaoArgs) -> Result<()> {
     }
     let loaded = files::load_system(&args.system)?;
     let sys = &loaded.system;
-    let omegas = match &args.omega {
-        Some(s) => Omegas::parse(s)?.0,
-        None => {
-            let (lo, hi) = sys.db.omega_range();
-            sys.db
-                .omega_rad_s
-                .iter()
-                .copied()
-                .filter(|w| *w >= lo && *w <= hi)
-                .collect()
-        }
-    };
-    let headings_deg: Vec<f64> = match &args.heading {
-        Some(h) => {
-            if let Some(bad) = h.iter().find(|v| !v.is_finite()) {
-                bail!("--heading {bad}: not a finite angle in degrees");
-            }
-            h.clone()
-        }
-        None => sys.db.heading_rad.iter().map(|h| h.to_degrees()).collect(),
-    };
+    let omegas = omegas_of(args, sys)?;
+    let headings_deg = headings_deg_of(args, sys)?;
     let headings_rad: Vec<f64> = headings_deg.iter().map(|h| h.to_radians()).collect();
     let context = || args.system.display().to_string();
     let dt_s = args.dt.unwrap_or_else(|| shipcast::rom::step::default_step(sys).dt_s);
@@ -148,63 +130,122 @@ pub fn run(args: &RaoArgs) -> Result<()> {
             let model = TimeModel::new(sys, flag_checked(opts)?).with_context(context)?;
             floor::implied_table(&model, &omegas, &headings_rad).with_context(context)?
         }
-        Method::Time => {
-            let t0 = std::time::Instant::now();
-            let opts = RomOptions {
-                dt_s,
-                radiation: args.radiation.into(),
-                speed_m_s: args.speed,
-                ..RomOptions::default()
-            };
-            // a system with databases at several speeds: the one at this speed
-            let at = sys.at_speed(args.speed).with_context(context)?;
-            let model = TimeModel::new(&at, flag_checked(opts)?).with_context(context)?;
-            // the headings are independent runs: one thread per core, each taking every n-th heading
-            let threads = std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .clamp(1, headings_deg.len().max(1));
-            let runs: Vec<Vec<(usize, _)>> = std::thread::scope(|scope| {
-                let handles: Vec<_> = (0..threads)
-                    .map(|t| {
-                        let (model, omegas, headings_deg) = (&model, &omegas, &headings_deg);
-                        scope.spawn(move || {
-                            (t..headings_deg.len())
-                                .step_by(threads)
-                                .map(|ih| {
-                                    let h: f64 = headings_deg[ih];
-                                    (
-                                        ih,
-                                        time_domain_rao(model, h.to_radians(), omegas, RegularOptions::default()),
-                                    )
-                                })
-                                .collect()
-                        })
-                    })
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|j| j.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-                    .collect()
-            });
-            let mut table = vec![vec![]; headings_deg.len()];
-            for (ih, r) in runs.into_iter().flatten() {
-                let h = headings_deg[ih];
-                let r = r.with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
-                tracing::info!(heading_deg = h, settled_s = r.settled_s, "steady state reached");
-                table[ih] = r.rao;
-            }
-            eprintln!(
-                "shipcast rao: time domain, {:?} radiation (memory {}), dt {} s: {} headings x {} frequencies in {:.2} s ({threads} threads)",
-                opts.radiation,
-                model.memory_size(),
-                opts.dt_s,
-                headings_deg.len(),
-                omegas.len(),
-                t0.elapsed().as_secs_f64()
-            );
-            table
-        }
+        Method::Time => time_table(args, sys, dt_s, &omegas, &headings_deg)?,
     };
+    write_csv(&omegas, &headings_deg, &table)
+}
+
+/// The frequencies of `--omega`, else the database's within its range, rad/s.
+fn omegas_of(args: &RaoArgs, sys: &VesselSystem) -> Result<Vec<f64>> {
+    Ok(match &args.omega {
+        Some(s) => Omegas::parse(s)?.0,
+        None => {
+            let (lo, hi) = sys.db.omega_range();
+            sys.db
+                .omega_rad_s
+                .iter()
+                .copied()
+                .filter(|w| *w >= lo && *w <= hi)
+                .collect()
+        }
+    })
+}
+
+/// The headings of `--heading` (refused unless finite), else the database's, deg.
+fn headings_deg_of(args: &RaoArgs, sys: &VesselSystem) -> Result<Vec<f64>> {
+    Ok(match &args.heading {
+        Some(h) => {
+            if let Some(bad) = h.iter().find(|v| !v.is_finite()) {
+                bail!("--heading {bad}: not a finite angle in degrees");
+            }
+            h.clone()
+        }
+        None => sys.db.heading_rad.iter().map(|h| h.to_degrees()).collect(),
+    })
+}
+
+/// The time-domain RAO table ([heading][omega][mode]): the model at `--speed` run in regular waves at
+/// every heading, the headings spread over the cores; a summary on stderr.
+fn time_table(
+    args: &RaoArgs,
+    sys: &VesselSystem,
+    dt_s: f64,
+    omegas: &[f64],
+    headings_deg: &[f64],
+) -> Result<floor::RaoTable> {
+    let t0 = std::time::Instant::now();
+    let context = || args.system.display().to_string();
+    let opts = RomOptions {
+        dt_s,
+        radiation: args.radiation.into(),
+        speed_m_s: args.speed,
+        ..RomOptions::default()
+    };
+    // a system with databases at several speeds: the one at this speed
+    let at = sys.at_speed(args.speed).with_context(context)?;
+    let model = TimeModel::new(&at, flag_checked(opts)?).with_context(context)?;
+    // the headings are independent runs: one thread per core, each taking every n-th heading
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, headings_deg.len().max(1));
+    let table = headings_in_threads(args, &model, omegas, headings_deg, threads)?;
+    eprintln!(
+        "shipcast rao: time domain, {:?} radiation (memory {}), dt {} s: {} headings x {} frequencies in {:.2} s ({threads} threads)",
+        opts.radiation,
+        model.memory_size(),
+        opts.dt_s,
+        headings_deg.len(),
+        omegas.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(table)
+}
+
+/// Runs `model` in regular waves at every heading on `threads` threads (thread t takes every
+/// `threads`-th heading from the t-th) and gathers the RAOs by heading; the first failed heading in
+/// heading order is the error.
+fn headings_in_threads(
+    args: &RaoArgs,
+    model: &TimeModel,
+    omegas: &[f64],
+    headings_deg: &[f64],
+    threads: usize,
+) -> Result<floor::RaoTable> {
+    let runs: Vec<Vec<(usize, _)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                scope.spawn(move || {
+                    (t..headings_deg.len())
+                        .step_by(threads)
+                        .map(|ih| {
+                            let h: f64 = headings_deg[ih];
+                            (
+                                ih,
+                                time_domain_rao(model, h.to_radians(), omegas, RegularOptions::default()),
+                            )
+                        })
+                        .collect()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|j| j.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    let mut table = vec![vec![]; headings_deg.len()];
+    for (ih, r) in runs.into_iter().flatten() {
+        let h = headings_deg[ih];
+        let r = r.with_context(|| format!("{}: heading {h} deg", args.system.display()))?;
+        tracing::info!(heading_deg = h, settled_s = r.settled_s, "steady state reached");
+        table[ih] = r.rao;
+    }
+    Ok(table)
+}
+
+/// Writes the table as CSV on stdout: a row per frequency, heading and mode (1-based), amplitude and
+/// phase in degrees.
+fn write_csv(omegas: &[f64], headings_deg: &[f64], table: &floor::RaoTable) -> Result<()> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     writeln!(out, "omega,heading_deg,mode,amplitude,phase_deg")?;
     for (iw, &w) in omegas.iter().enumerate() {

@@ -1,6 +1,6 @@
 //! `shipcast replay LOG`: a recorded log through the daemon's engine, with a skill report.
 
-use super::daemon::load_config;
+use super::load_config;
 use super::plot;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -71,7 +71,7 @@ fn is_mcap(path: &std::path::Path) -> Result<()> {
 
 pub fn run(a: &ReplayArgs) -> Result<()> {
     let cfg = load_config(&a.config)?;
-    let sys = super::daemon::load_system(&cfg)?;
+    let sys = super::load_system(&cfg)?;
     if let Some(s) = a.speed
         && !(s.is_finite() && s > 0.0)
     {
@@ -503,56 +503,11 @@ fn report(
         let mut dofs = vec![];
         for (d, dof) in shipcast::hydro::Dof::NAMES.iter().enumerate() {
             let measured = &measured_all[6 * b + d];
-            let fs: Vec<SeriesForecast> = forecasts
-                .iter()
-                .map(|f| {
-                    let n = f.steps as usize + 1;
-                    let s = 6 * b + d;
-                    SeriesForecast {
-                        t0_s: f.issue_time_s,
-                        dt_s: f.dt_s,
-                        values: f.values.get(s * n..(s + 1) * n).unwrap_or(&[]),
-                        sigma: f.sigma.get(s * n..(s + 1) * n).unwrap_or(&[]),
-                    }
-                })
-                .collect();
+            let fs = series_forecasts(forecasts, 6 * b + d);
             let sk = skill::score(&fs, measured, step, length_s);
             lead = sk.lead_s.clone();
-            let arr = |v: &[f64]| {
-                v.iter()
-                    .map(|x| {
-                        if x.is_finite() {
-                            format!("{x:.5}")
-                        } else {
-                            "null".into()
-                        }
-                    })
-                    .collect::<Vec<_>>()
-                    .join(",")
-            };
-            dofs.push(format!(
-                "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"spread_skill\":[{}],\"count\":[{}]}}",
-                arr(&sk.correlation),
-                arr(&sk.nrmse),
-                arr(&sk.ssp),
-                arr(&sk.bias),
-                arr(&sk.coverage_90),
-                arr(&sk.spread_skill),
-                sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")
-            ));
-            for l in 0..sk.lead_s.len() {
-                csv.push_str(&format!(
-                    "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
-                    sk.lead_s[l],
-                    sk.correlation[l],
-                    sk.nrmse[l],
-                    sk.ssp[l],
-                    sk.bias[l],
-                    sk.coverage_90[l],
-                    sk.spread_skill[l],
-                    sk.count[l]
-                ));
-            }
+            dofs.push(dof_skill_json(dof, &sk));
+            push_skill_csv(&mut csv, name, dof, &sk);
             if ["heave", "roll", "pitch"].contains(dof) {
                 curves.push(plot::SkillCurve {
                     label: format!("{name} {dof}"),
@@ -563,29 +518,7 @@ fn report(
         }
         json_vessels.push(format!("\"{name}\":{{{}}}", dofs.join(",")));
     }
-    let lead_json = lead.iter().map(|l| format!("{l}")).collect::<Vec<_>>().join(",");
-    // the median published trusted span of each vessel over the log
-    let median = |get: fn(&ForecastRecord) -> &Vec<f64>| -> String {
-        (0..nb)
-            .map(|b| {
-                let mut v: Vec<f64> = forecasts.iter().filter_map(|f| get(f).get(b).copied()).collect();
-                v.sort_by(f64::total_cmp);
-                let m = v.get(v.len() / 2).map_or("null".to_string(), |x| format!("{x:.3}"));
-                format!("\"{}\":{m}", sys.spec.bodies[b].name)
-            })
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    let horizons = median(|f| &f.horizon_s);
-    let froms = median(|f| &f.trusted_from_s);
-    std::fs::write(
-        dir.join("skill.json"),
-        format!(
-            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"trusted_horizon_s\":{{{horizons}}},\"trusted_from_s\":{{{froms}}},\"vessels\":{{{}}}}}\n",
-            forecasts.len(),
-            json_vessels.join(",")
-        ),
-    )?;
+    write_skill_json(dir, sys, reference, forecasts, &lead, &json_vessels)?;
     std::fs::write(dir.join("skill.csv"), csv)?;
     plot::skill(&dir.join("skill.svg"), forecasts.len(), reference, &lead, &curves)?;
     let mut out = std::io::stdout().lock();
@@ -593,6 +526,110 @@ fn report(
         out,
         "report (against the {reference} motion): {}/skill.json, skill.csv, skill.svg, skill.png",
         dir.display()
+    )?;
+    Ok(())
+}
+
+/// Series `s` (6 per vessel) of every forecast, with its band, as [`skill::score`] takes them.
+fn series_forecasts(forecasts: &[ForecastRecord], s: usize) -> Vec<SeriesForecast<'_>> {
+    forecasts
+        .iter()
+        .map(|f| {
+            let n = f.steps as usize + 1;
+            SeriesForecast {
+                t0_s: f.issue_time_s,
+                dt_s: f.dt_s,
+                values: f.values.get(s * n..(s + 1) * n).unwrap_or(&[]),
+                sigma: f.sigma.get(s * n..(s + 1) * n).unwrap_or(&[]),
+            }
+        })
+        .collect()
+}
+
+/// Numbers as the inside of a JSON array, 5 decimals, null where not finite.
+fn json_numbers(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| {
+            if x.is_finite() {
+                format!("{x:.5}")
+            } else {
+                "null".into()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// One DOF's skill as a JSON member, `"dof":{...}`: a value per lead of every score.
+fn dof_skill_json(dof: &str, sk: &skill::Skill) -> String {
+    format!(
+        "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"spread_skill\":[{}],\"count\":[{}]}}",
+        json_numbers(&sk.correlation),
+        json_numbers(&sk.nrmse),
+        json_numbers(&sk.ssp),
+        json_numbers(&sk.bias),
+        json_numbers(&sk.coverage_90),
+        json_numbers(&sk.spread_skill),
+        sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")
+    )
+}
+
+/// Appends a CSV row per lead of one DOF's skill to `csv`.
+fn push_skill_csv(csv: &mut String, name: &str, dof: &str, sk: &skill::Skill) {
+    for l in 0..sk.lead_s.len() {
+        csv.push_str(&format!(
+            "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
+            sk.lead_s[l],
+            sk.correlation[l],
+            sk.nrmse[l],
+            sk.ssp[l],
+            sk.bias[l],
+            sk.coverage_90[l],
+            sk.spread_skill[l],
+            sk.count[l]
+        ));
+    }
+}
+
+/// The median over the log of a per-vessel value of the forecasts (`get`), as JSON members
+/// `"vessel":value` (null when no forecast has it).
+fn vessel_medians(
+    sys: &shipcast::hydro::VesselSystem,
+    forecasts: &[ForecastRecord],
+    get: fn(&ForecastRecord) -> &Vec<f64>,
+) -> String {
+    (0..sys.spec.bodies.len())
+        .map(|b| {
+            let mut v: Vec<f64> = forecasts.iter().filter_map(|f| get(f).get(b).copied()).collect();
+            v.sort_by(f64::total_cmp);
+            let m = v.get(v.len() / 2).map_or("null".to_string(), |x| format!("{x:.3}"));
+            format!("\"{}\":{m}", sys.spec.bodies[b].name)
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// Writes `skill.json`: the leads, the number of forecasts, the median trusted span of each vessel,
+/// and the vessels' skill (`json_vessels`, a JSON member each).
+fn write_skill_json(
+    dir: &Path,
+    sys: &shipcast::hydro::VesselSystem,
+    reference: &str,
+    forecasts: &[ForecastRecord],
+    lead_s: &[f64],
+    json_vessels: &[String],
+) -> Result<()> {
+    let lead_json = lead_s.iter().map(|l| format!("{l}")).collect::<Vec<_>>().join(",");
+    // the median published trusted span of each vessel over the log
+    let horizons = vessel_medians(sys, forecasts, |f| &f.horizon_s);
+    let froms = vessel_medians(sys, forecasts, |f| &f.trusted_from_s);
+    std::fs::write(
+        dir.join("skill.json"),
+        format!(
+            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"trusted_horizon_s\":{{{horizons}}},\"trusted_from_s\":{{{froms}}},\"vessels\":{{{}}}}}\n",
+            forecasts.len(),
+            json_vessels.join(",")
+        ),
     )?;
     Ok(())
 }
@@ -629,7 +666,7 @@ pub struct ImportArgs {
 pub fn import(a: &ImportArgs) -> Result<()> {
     use shipcast::shell::replay::import::{ProbeOptions, default_probe_window_s, motion_csv, probe_csv, probe_fields};
     let cfg = load_config(&a.config)?;
-    let sys = super::daemon::load_system(&cfg)?;
+    let sys = super::load_system(&cfg)?;
     let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
     if a.motion.is_empty() && a.probe.is_empty() {
         bail!("nothing to import: give --motion and/or --probe files");

@@ -1,7 +1,7 @@
 //! Drawing the console (pure: into a ratatui frame). The words an operator reads are decided by
 //! [`banner`] and [`health_lines`] (tested on their own); [`draw`] lays them out with the charts.
 
-use super::{Console, Link};
+use super::{Console, Forecast, Health, Link, LinkHealth, Outlook};
 use crate::operation::{Channel, Verdict};
 use ratatui::Frame;
 use ratatui::layout::{Alignment, Constraint, Layout, Rect};
@@ -32,66 +32,11 @@ fn colour(c: &Console, s: Severity) -> Color {
 
 /// The one line that matters: can the operation start now, or why the console cannot say.
 pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
-    let d = c.settings.duration_s;
-    match c.link(now_wall_s) {
-        Link::Waiting => {
-            return (
-                Severity::Caution,
-                "Waiting for shipcast: no forecast or status yet (is `shipcast run` running?)".into(),
-            );
-        }
-        Link::Stopped => {
-            return (
-                Severity::Alarm,
-                "shipcast has STOPPED: no forecast. Do not use the traces below.".into(),
-            );
-        }
-        Link::Silent { silent_s } => {
-            return (
-                Severity::Alarm,
-                format!("shipcast NOT RESPONDING for {silent_s:.0} s: the forecast below is STALE, do not use it"),
-            );
-        }
-        Link::Live => {}
+    if let Some(b) = link_banner(c.link(now_wall_s)) {
+        return b;
     }
     if !c.forecast_is_current(now_wall_s) {
-        let h = c.health.as_ref();
-        let has = |f: &str| h.is_some_and(|h| h.flags.contains(&f));
-        let why = if has("no_waves") {
-            match h.map(|h| h.wave_age_s) {
-                Some(a) if a >= 0.0 => format!("radar data {a:.0} s old"),
-                _ => "no radar data yet".into(),
-            }
-        } else if has("no_motion") {
-            let stale: Vec<String> = h
-                .map(|h| {
-                    h.motion_age_s
-                        .iter()
-                        .zip(&c.vessels)
-                        .filter(|(a, _)| **a < 0.0 || **a > 2.0)
-                        .map(|(a, n)| {
-                            if *a < 0.0 {
-                                format!("no IMU data from {n}")
-                            } else {
-                                format!("{n} IMU data {a:.0} s old")
-                            }
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
-            if stale.is_empty() {
-                "no motion data".into()
-            } else {
-                stale.join(", ")
-            }
-        } else if has("numerical_trouble") {
-            "the model diverged".into()
-        } else {
-            match &c.forecast {
-                Some(f) => format!("last forecast {:.0} s ago", now_wall_s - f.received_wall_s),
-                None => "no forecast yet".into(),
-            }
-        };
+        let why = suspended_reason(c, now_wall_s);
         return (
             Severity::Alarm,
             format!("Forecast suspended: {why}. NO-GO until it returns."),
@@ -100,6 +45,77 @@ pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
     let Some(o) = c.outlook() else {
         return (Severity::Caution, "No channels chosen: press a to add one".into());
     };
+    verdict_banner(c, &o)
+}
+
+/// The banner when the daemon is not live (waiting, stopped or silent); `None` when it is.
+fn link_banner(link: Link) -> Option<(Severity, String)> {
+    match link {
+        Link::Waiting => Some((
+            Severity::Caution,
+            "Waiting for shipcast: no forecast or status yet (is `shipcast run` running?)".into(),
+        )),
+        Link::Stopped => Some((
+            Severity::Alarm,
+            "shipcast has STOPPED: no forecast. Do not use the traces below.".into(),
+        )),
+        Link::Silent { silent_s } => Some((
+            Severity::Alarm,
+            format!("shipcast NOT RESPONDING for {silent_s:.0} s: the forecast below is STALE, do not use it"),
+        )),
+        Link::Live => None,
+    }
+}
+
+/// Why the forecast is not current, in an operator's words: the radar, the IMUs, the model, or its age.
+fn suspended_reason(c: &Console, now_wall_s: f64) -> String {
+    let h = c.health.as_ref();
+    let has = |f: &str| h.is_some_and(|h| h.flags.contains(&f));
+    if has("no_waves") {
+        match h.map(|h| h.wave_age_s) {
+            Some(a) if a >= 0.0 => format!("radar data {a:.0} s old"),
+            _ => "no radar data yet".into(),
+        }
+    } else if has("no_motion") {
+        stale_motion_reason(c, h)
+    } else if has("numerical_trouble") {
+        "the model diverged".into()
+    } else {
+        match &c.forecast {
+            Some(f) => format!("last forecast {:.0} s ago", now_wall_s - f.received_wall_s),
+            None => "no forecast yet".into(),
+        }
+    }
+}
+
+/// The vessels whose IMU data is missing or older than 2 s, or "no motion data" when none is.
+fn stale_motion_reason(c: &Console, h: Option<&Health>) -> String {
+    let stale: Vec<String> = h
+        .map(|h| {
+            h.motion_age_s
+                .iter()
+                .zip(&c.vessels)
+                .filter(|(a, _)| **a < 0.0 || **a > 2.0)
+                .map(|(a, n)| {
+                    if *a < 0.0 {
+                        format!("no IMU data from {n}")
+                    } else {
+                        format!("{n} IMU data {a:.0} s old")
+                    }
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if stale.is_empty() {
+        "no motion data".into()
+    } else {
+        stale.join(", ")
+    }
+}
+
+/// The banner for a current forecast: go, no-go or can't tell, from the outlook `o`.
+fn verdict_banner(c: &Console, o: &Outlook) -> (Severity, String) {
+    let d = c.settings.duration_s;
     match o.verdict {
         Verdict::Go { window_s } => (
             Severity::Ok,
@@ -126,32 +142,52 @@ pub fn banner(c: &Console, now_wall_s: f64) -> (Severity, String) {
                 o.trusted_s
             ),
         ),
-        Verdict::NoGo { next_window_in_s } => {
-            let who = match &o.first_exceedance {
-                Some((n, t)) if *t <= 0.0 => format!("{n} outside its limit now"),
-                Some((n, t)) => format!("{n} leaves its limit in {}", fmt_in(*t)),
-                None => "a channel leaves its limit".into(),
-            };
-            let next = match next_window_in_s {
-                Some(t) => format!("next window in {}", fmt_in(t)),
-                None => format!("no {d:.0} s window within the trusted {:.0} s", o.trusted_s),
-            };
-            (
-                Severity::Alarm,
-                format!(
-                    "NO-GO ({:.0} % confidence): {who}; {next}",
-                    100.0 * c.settings.confidence
-                ),
-            )
-        }
+        Verdict::NoGo { next_window_in_s } => no_go_banner(c, o, next_window_in_s),
     }
+}
+
+/// The no-go banner: which channel leaves its limit and when, and when the next window opens.
+fn no_go_banner(c: &Console, o: &Outlook, next_window_in_s: Option<f64>) -> (Severity, String) {
+    let d = c.settings.duration_s;
+    let who = match &o.first_exceedance {
+        Some((n, t)) if *t <= 0.0 => format!("{n} outside its limit now"),
+        Some((n, t)) => format!("{n} leaves its limit in {}", fmt_in(*t)),
+        None => "a channel leaves its limit".into(),
+    };
+    let next = match next_window_in_s {
+        Some(t) => format!("next window in {}", fmt_in(t)),
+        None => format!("no {d:.0} s window within the trusted {:.0} s", o.trusted_s),
+    };
+    (
+        Severity::Alarm,
+        format!(
+            "NO-GO ({:.0} % confidence): {who}; {next}",
+            100.0 * c.settings.confidence
+        ),
+    )
 }
 
 /// The inputs' health in an operator's words.
 pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
     let mut out = vec![];
     let link = c.link(now_wall_s);
-    out.push(match link {
+    out.push(daemon_line(c, link));
+    if let Some(f) = &c.forecast {
+        forecast_lines(c, f, now_wall_s, &mut out);
+    }
+    if let Some(h) = &c.health {
+        sensor_lines(c, h, &mut out);
+        if let Some(l) = &h.link {
+            out.push(ship_link_line(l));
+        }
+        flag_lines(c, h, &mut out);
+    }
+    out
+}
+
+/// The daemon's state: waiting, live (with its forecast period), silent or stopped.
+fn daemon_line(c: &Console, link: Link) -> (Severity, String) {
+    match link {
         Link::Waiting => (Severity::Caution, "shipcast: waiting".to_string()),
         Link::Live => (
             Severity::Ok,
@@ -159,107 +195,117 @@ pub fn health_lines(c: &Console, now_wall_s: f64) -> Vec<(Severity, String)> {
         ),
         Link::Silent { silent_s } => (Severity::Alarm, format!("shipcast: silent for {silent_s:.0} s")),
         Link::Stopped => (Severity::Alarm, "shipcast: stopped".into()),
+    }
+}
+
+/// Pushes the forecast's age and compute time, then each vessel's trusted span, onto `out`.
+fn forecast_lines(c: &Console, f: &Forecast, now_wall_s: f64, out: &mut Vec<(Severity, String)>) {
+    let age = now_wall_s - f.received_wall_s;
+    let s = if c.forecast_is_current(now_wall_s) {
+        Severity::Ok
+    } else {
+        Severity::Alarm
+    };
+    out.push((
+        s,
+        format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
+    ));
+    for (b, (n, h)) in c.vessels.iter().zip(&f.horizon_s).enumerate() {
+        match f.trusted_from_s.get(b).copied().filter(|x| *x > 0.0) {
+            Some(from) => out.push((Severity::Caution, format!("Trusted ahead: {n} {from:.0}-{h:.0} s"))),
+            None => out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s"))),
+        }
+    }
+}
+
+/// Pushes the radar's data age, then each vessel's IMU age and rate, onto `out`.
+fn sensor_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
+    out.push(match h.wave_age_s {
+        a if a < 0.0 => (Severity::Alarm, "Radar: no data yet".into()),
+        a if h.flags.contains(&"no_waves") => {
+            (Severity::Alarm, format!("Radar: data {a:.0} s old, forecast suspended"))
+        }
+        a if h.flags.contains(&"stale_waves") => (
+            Severity::Caution,
+            format!("Radar: data {a:.0} s old, forecast less sure"),
+        ),
+        a => (Severity::Ok, format!("Radar: data {a:.1} s old")),
     });
-    if let Some(f) = &c.forecast {
-        let age = now_wall_s - f.received_wall_s;
-        let s = if c.forecast_is_current(now_wall_s) {
-            Severity::Ok
+    for ((n, a), r) in c.vessels.iter().zip(&h.motion_age_s).zip(&h.motion_rate_hz) {
+        out.push(if *a < 0.0 {
+            (Severity::Alarm, format!("{n} IMU: no data yet"))
+        } else if *a > 2.0 {
+            (Severity::Alarm, format!("{n} IMU: no data for {a:.0} s"))
         } else {
-            Severity::Alarm
-        };
-        out.push((
-            s,
-            format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
-        ));
-        for (b, (n, h)) in c.vessels.iter().zip(&f.horizon_s).enumerate() {
-            match f.trusted_from_s.get(b).copied().filter(|x| *x > 0.0) {
-                Some(from) => out.push((Severity::Caution, format!("Trusted ahead: {n} {from:.0}-{h:.0} s"))),
-                None => out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s"))),
-            }
-        }
-    }
-    if let Some(h) = &c.health {
-        out.push(match h.wave_age_s {
-            a if a < 0.0 => (Severity::Alarm, "Radar: no data yet".into()),
-            a if h.flags.contains(&"no_waves") => {
-                (Severity::Alarm, format!("Radar: data {a:.0} s old, forecast suspended"))
-            }
-            a if h.flags.contains(&"stale_waves") => (
-                Severity::Caution,
-                format!("Radar: data {a:.0} s old, forecast less sure"),
-            ),
-            a => (Severity::Ok, format!("Radar: data {a:.1} s old")),
+            (Severity::Ok, format!("{n} IMU: {a:.1} s old, {r:.0} Hz"))
         });
-        for ((n, a), r) in c.vessels.iter().zip(&h.motion_age_s).zip(&h.motion_rate_hz) {
-            out.push(if *a < 0.0 {
-                (Severity::Alarm, format!("{n} IMU: no data yet"))
-            } else if *a > 2.0 {
-                (Severity::Alarm, format!("{n} IMU: no data for {a:.0} s"))
-            } else {
-                (Severity::Ok, format!("{n} IMU: {a:.1} s old, {r:.0} Hz"))
-            });
-        }
-        if let Some(l) = &h.link {
-            let lat = if l.latency_ms >= 0.0 {
-                format!("{:.0} ms", l.latency_ms)
-            } else {
-                "-".into()
-            };
-            let loss = if l.loss >= 0.0 {
-                format!("{:.0} %", 100.0 * l.loss)
-            } else {
-                "-".into()
-            };
-            out.push(match (l.up, l.age_s) {
-                (true, a) => (
-                    Severity::Ok,
-                    format!("Link to the other ship: up, latency {lat}, loss {loss}, last {a:.1} s ago"),
+    }
+}
+
+/// The ship-to-ship link: up with its latency and loss, or down and for how long.
+fn ship_link_line(l: &LinkHealth) -> (Severity, String) {
+    let lat = if l.latency_ms >= 0.0 {
+        format!("{:.0} ms", l.latency_ms)
+    } else {
+        "-".into()
+    };
+    let loss = if l.loss >= 0.0 {
+        format!("{:.0} %", 100.0 * l.loss)
+    } else {
+        "-".into()
+    };
+    match (l.up, l.age_s) {
+        (true, a) => (
+            Severity::Ok,
+            format!("Link to the other ship: up, latency {lat}, loss {loss}, last {a:.1} s ago"),
+        ),
+        (false, a) if a < 0.0 => (Severity::Alarm, "Link to the other ship: nothing heard yet".into()),
+        (false, a) => (
+            Severity::Alarm,
+            format!("Link to the other ship: down, nothing for {a:.0} s (loss {loss})"),
+        ),
+    }
+}
+
+/// Pushes the lines of the health's flags (warm-up, clocks, radar, gaps, divergence) and the
+/// overruns onto `out`.
+fn flag_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
+    if h.flags.contains(&"history_short") {
+        out.push((
+            Severity::Caution,
+            match c.warmup() {
+                Some((_, left)) => format!(
+                    "Warming up: {left:.0} s more until the {:.0} s motion memory is full; less sure until then",
+                    c.settings.history_wanted_s
                 ),
-                (false, a) if a < 0.0 => (Severity::Alarm, "Link to the other ship: nothing heard yet".into()),
-                (false, a) => (
-                    Severity::Alarm,
-                    format!("Link to the other ship: down, nothing for {a:.0} s (loss {loss})"),
-                ),
-            });
-        }
-        if h.flags.contains(&"history_short") {
-            out.push((
-                Severity::Caution,
-                match c.warmup() {
-                    Some((_, left)) => format!(
-                        "Warming up: {left:.0} s more until the {:.0} s motion memory is full; less sure until then",
-                        c.settings.history_wanted_s
-                    ),
-                    None => "Motion history short (a gap or a restart): less sure".into(),
-                },
-            ));
-        }
-        for (flag, words) in [
-            ("clocks_disagree", "Sensor clocks disagree: no forecast"),
-            ("clock_step", "A sensor clock stepped: re-synchronized"),
-            ("wave_region_unknown", "Radar: field without its region: not trusted"),
-            ("no_wave_components", "Radar: an empty field: not trusted"),
-            ("waves_dropped", "Part of the sea is outside the vessel database"),
-            (
-                "model_error_unchecked",
-                "Learning the model's error: no lead trusted until forecasts are checked",
-            ),
-        ] {
-            if h.flags.contains(&flag) {
-                out.push((Severity::Caution, words.into()));
-            }
-        }
-        if h.flags.contains(&"history_gap") {
-            out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));
-        }
-        if h.flags.contains(&"numerical_trouble") {
-            out.push((Severity::Alarm, "The model diverged: no forecast".into()));
-        }
-        if h.overruns > 0 {
-            out.push((Severity::Caution, format!("{} forecasts ran late", h.overruns)));
+                None => "Motion history short (a gap or a restart): less sure".into(),
+            },
+        ));
+    }
+    for (flag, words) in [
+        ("clocks_disagree", "Sensor clocks disagree: no forecast"),
+        ("clock_step", "A sensor clock stepped: re-synchronized"),
+        ("wave_region_unknown", "Radar: field without its region: not trusted"),
+        ("no_wave_components", "Radar: an empty field: not trusted"),
+        ("waves_dropped", "Part of the sea is outside the vessel database"),
+        (
+            "model_error_unchecked",
+            "Learning the model's error: no lead trusted until forecasts are checked",
+        ),
+    ] {
+        if h.flags.contains(&flag) {
+            out.push((Severity::Caution, words.into()));
         }
     }
-    out
+    if h.flags.contains(&"history_gap") {
+        out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));
+    }
+    if h.flags.contains(&"numerical_trouble") {
+        out.push((Severity::Alarm, "The model diverged: no forecast".into()));
+    }
+    if h.overruns > 0 {
+        out.push((Severity::Caution, format!("{} forecasts ran late", h.overruns)));
+    }
 }
 
 /// Four evenly spaced time labels (ratatui spreads labels evenly), "now" at 0.
@@ -333,9 +379,75 @@ pub fn draw(frame: &mut Frame, c: &Console, now_wall_s: f64) {
     }
 }
 
+/// Draws one channel's chart: the measured motion, the forecast with its band and trusted span, the
+/// limits and now.
 fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected: bool, now_wall_s: f64) {
-    let colours = &c.settings.colours;
     let current = c.forecast_is_current(now_wall_s);
+    let hist = c.settings.history_s;
+    let s = chart_series(c, ch);
+    let x_max = s.span_s.max(10.0);
+    let y = chart_peak(&s, ch.limit) * 1.05;
+    let marks = ChartMarks {
+        limit_hi: [(-hist, ch.limit), (x_max, ch.limit)],
+        limit_lo: [(-hist, -ch.limit), (x_max, -ch.limit)],
+        horizon: [(s.horizon_s, -y), (s.horizon_s, y)],
+        from: [(s.from_s, -y), (s.from_s, y)],
+        now: [(0.0, -y), (0.0, y)],
+    };
+    let sets = chart_datasets(c, &s, &marks, current);
+    let title = chart_title(c, ch, &s, selected, current);
+    let chart = Chart::new(sets)
+        .block(Block::default().borders(Borders::ALL).title(title))
+        .x_axis(
+            Axis::default()
+                .bounds([-hist, x_max])
+                .labels(time_labels(-hist, x_max))
+                .style(Style::default().fg(Color::Gray)),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([-y, y])
+                .labels([format!("{:.1}", -y), "0".into(), format!("{y:.1}")])
+                .style(Style::default().fg(Color::Gray)),
+        );
+    frame.render_widget(chart, area);
+}
+
+/// One channel's traces on a chart, in (s from the forecast's issue, channel units).
+struct ChartSeries {
+    /// The forecast's length, s.
+    span_s: f64,
+    /// The end of the trusted span, s.
+    horizon_s: f64,
+    /// The start of the trusted span, s.
+    from_s: f64,
+    /// The first sample of the trusted span.
+    k_f: usize,
+    /// The forecast within the trusted span.
+    trusted: Vec<(f64, f64)>,
+    /// The forecast before the trusted span.
+    before: Vec<(f64, f64)>,
+    /// The forecast beyond the trusted span.
+    beyond: Vec<(f64, f64)>,
+    /// The band's upper edge: forecast + z sigma.
+    band_hi: Vec<(f64, f64)>,
+    /// The band's lower edge: forecast - z sigma.
+    band_lo: Vec<(f64, f64)>,
+    /// The measured motion over the history shown.
+    measured: Vec<(f64, f64)>,
+}
+
+/// The straight lines of a chart: the limits, the trusted span's ends and now.
+struct ChartMarks {
+    limit_hi: [(f64, f64); 2],
+    limit_lo: [(f64, f64); 2],
+    horizon: [(f64, f64); 2],
+    from: [(f64, f64); 2],
+    now: [(f64, f64); 2],
+}
+
+/// The forecast of `ch` split at its trusted span, its band, and the measured motion before it.
+fn chart_series(c: &Console, ch: &Channel) -> ChartSeries {
     let hist = c.settings.history_s;
     let (t0, dt) = c.forecast.as_ref().map_or_else(
         || (c.latest_measured_s().unwrap_or(0.0), 1.0),
@@ -366,53 +478,76 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     };
     let (band_hi, band_lo) = (band(1.0), band(-1.0));
     let measured = c.measured_channel(ch, t0, -hist);
-    let x_max = span_s.max(10.0);
-    // the band within the trusted span sets the scale too (beyond it, it may grow without bound)
-    let band_trusted = band_hi
+    ChartSeries {
+        span_s,
+        horizon_s: horizon,
+        from_s: from,
+        k_f,
+        trusted,
+        before,
+        beyond,
+        band_hi,
+        band_lo,
+        measured,
+    }
+}
+
+/// The largest magnitude the chart shows (at least 1.2 times `limit`): of the traces and of the band
+/// within the trusted span (beyond it, it may grow without bound).
+fn chart_peak(s: &ChartSeries, limit: f64) -> f64 {
+    let band_trusted = s
+        .band_hi
         .iter()
-        .chain(&band_lo)
-        .filter(|p| p.0 >= from - 1e-9 && p.0 <= horizon + 1e-9);
-    let peak = trusted
+        .chain(&s.band_lo)
+        .filter(|p| p.0 >= s.from_s - 1e-9 && p.0 <= s.horizon_s + 1e-9);
+    s.trusted
         .iter()
-        .chain(&beyond)
-        .chain(&before)
-        .chain(&measured)
+        .chain(&s.beyond)
+        .chain(&s.before)
+        .chain(&s.measured)
         .chain(band_trusted)
         .map(|p| p.1.abs())
         .filter(|v| v.is_finite())
-        .fold(ch.limit * 1.2, f64::max);
-    let y = peak * 1.05;
-    let limit_hi = [(-hist, ch.limit), (x_max, ch.limit)];
-    let limit_lo = [(-hist, -ch.limit), (x_max, -ch.limit)];
-    let horizon_mark = [(horizon, -y), (horizon, y)];
-    let from_mark = [(from, -y), (from, y)];
-    let now_mark = [(0.0, -y), (0.0, y)];
+        .fold(limit * 1.2, f64::max)
+}
+
+/// The chart's lines in drawing order: limits and now, then (with a forecast) the span's marks, the
+/// band and the forecast, then the measured motion on top.
+fn chart_datasets<'a>(c: &Console, s: &'a ChartSeries, m: &'a ChartMarks, current: bool) -> Vec<Dataset<'a>> {
+    let colours = &c.settings.colours;
     let fc_colour = if current {
         colours.forecast
     } else {
         colours.beyond_horizon
     };
     let mut sets = vec![
-        set(&limit_hi, colours.limit),
-        set(&limit_lo, colours.limit),
-        set(&now_mark, Color::DarkGray),
+        set(&m.limit_hi, colours.limit),
+        set(&m.limit_lo, colours.limit),
+        set(&m.now, Color::DarkGray),
     ];
     if c.forecast.is_some() {
-        sets.push(set(&horizon_mark, colours.beyond_horizon));
-        if k_f > 0 {
-            sets.push(set(&from_mark, colours.beyond_horizon));
-            sets.push(set(&before, colours.beyond_horizon));
+        sets.push(set(&m.horizon, colours.beyond_horizon));
+        if s.k_f > 0 {
+            sets.push(set(&m.from, colours.beyond_horizon));
+            sets.push(set(&s.before, colours.beyond_horizon));
         }
-        sets.push(set(&band_hi, colours.beyond_horizon));
-        sets.push(set(&band_lo, colours.beyond_horizon));
-        sets.push(set(&beyond, colours.beyond_horizon));
-        sets.push(set(&trusted, fc_colour));
+        sets.push(set(&s.band_hi, colours.beyond_horizon));
+        sets.push(set(&s.band_lo, colours.beyond_horizon));
+        sets.push(set(&s.beyond, colours.beyond_horizon));
+        sets.push(set(&s.trusted, fc_colour));
     }
-    sets.push(set(&measured, colours.measured));
+    sets.push(set(&s.measured, colours.measured));
+    sets
+}
+
+/// The chart's title: the channel, its unit and limit, and its trusted span (or STALE); bold when
+/// `selected`.
+fn chart_title(c: &Console, ch: &Channel, s: &ChartSeries, selected: bool, current: bool) -> Span<'static> {
+    let (from, horizon) = (s.from_s, s.horizon_s);
     let marker = if selected { "▶ " } else { "" };
     let status = if c.forecast.is_none() {
         String::new()
-    } else if current && k_f > 0 {
+    } else if current && s.k_f > 0 {
         format!(" · trusted {from:.0}-{horizon:.0} s")
     } else if current {
         format!(" · trusted {horizon:.0} s")
@@ -425,25 +560,7 @@ fn draw_chart(frame: &mut Frame, area: Rect, c: &Console, ch: &Channel, selected
     } else {
         Style::default()
     };
-    let chart = Chart::new(sets)
-        .block(
-            Block::default()
-                .borders(Borders::ALL)
-                .title(Span::styled(title, title_style)),
-        )
-        .x_axis(
-            Axis::default()
-                .bounds([-hist, x_max])
-                .labels(time_labels(-hist, x_max))
-                .style(Style::default().fg(Color::Gray)),
-        )
-        .y_axis(
-            Axis::default()
-                .bounds([-y, y])
-                .labels([format!("{:.1}", -y), "0".into(), format!("{y:.1}")])
-                .style(Style::default().fg(Color::Gray)),
-        );
-    frame.render_widget(chart, area);
+    Span::styled(title, title_style)
 }
 
 /// A line through `data`.

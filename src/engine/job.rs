@@ -4,7 +4,8 @@
 use super::message::{ForecastHeader, MAX_VESSELS, flags};
 use super::*;
 use crate::band::{ResponseTable, SpreadOptions};
-use crate::rom::{ForecastRequest, Forecaster, Memory, RomOptions, Track};
+use crate::radiation::history::Memory;
+use crate::rom::{ForecastRequest, Forecaster, RomOptions, Track};
 
 /// One forecast job.
 #[derive(Debug, Clone)]

@@ -291,6 +291,31 @@ pub struct LinkStatus {
     pub sent: u64,
 }
 
+impl MotionSample {
+    /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
+    pub const TYPE_NAME: &'static str = "shipcast_MotionSample_v1";
+}
+
+impl NavigationSample {
+    /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
+    pub const TYPE_NAME: &'static str = "shipcast_NavigationSample_v1";
+}
+
+impl ForecastHeader {
+    /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
+    pub const TYPE_NAME: &'static str = "shipcast_ForecastHeader_v2";
+}
+
+impl Status {
+    /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
+    pub const TYPE_NAME: &'static str = "shipcast_Status_v4";
+}
+
+impl LinkStatus {
+    /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
+    pub const TYPE_NAME: &'static str = "shipcast_LinkStatus_v1";
+}
+
 /// Checks a received forecast against its own header, as every consumer must before indexing it
 /// (`ForecastSubscriber` does, for `watch`, `demo` and the console): the schema, the vessel count, the
 /// series count and the payload's length (displacements and standard deviations), a positive step,

@@ -1,9 +1,9 @@
 //! The vessel system and its hydrodynamic database (pure: values in, values out, no IO).
 //!
 //! Owns: the WAMIT readers ([`wamit`]), the system file ([`system`]), the assembled database with its
-//! interpolation over frequency and heading ([`db`]), and radiation: impulse response functions,
-//! A_inf and the Kramers-Kronig check ([`radiation`]), the radiation memory the time-domain models are
-//! built from ([`memory`]), the state-space fit ([`statespace`]) and `db check`'s checks ([`check`]).
+//! interpolation over frequency and heading ([`db`]) and the external models ([`external`]). What the
+//! database's radiation makes (impulse responses, A_inf, the state-space fit, the checks) is
+//! [`crate::radiation`]'s.
 //!
 //! Conventions (DESIGN.md section 1, contracts):
 //! - SI units: m, s, kg, N, rad. Degrees only where a name says `_deg`.

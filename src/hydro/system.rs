@@ -439,14 +439,10 @@ pub fn mass_matrix_from_properties(mass_kg: f64, cog_m: Vector3<f64>, radii_m: V
     m
 }
 
-fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
+/// A body's mass matrix about its reference point, from `mass_matrix` or from mass, centre of gravity
+/// and radii of gyration: symmetric and positive definite.
+fn body_mass(b: &BodyFile) -> std::result::Result<Matrix6<f64>, FieldErr> {
     let err = |f: &str, m: String| (f.to_string(), m);
-    if b.name.trim().is_empty() {
-        return Err(err("name", format!("body {k} needs a non-empty name")));
-    }
-    if b.position.iter().any(|v| !v.is_finite()) {
-        return Err(err("position", "must be three finite numbers (m)".into()));
-    }
     let props = (b.mass, b.centre_of_gravity, b.radii_of_gyration);
     let mass = match (&b.mass_matrix, props) {
         (Some(m), (None, None, None)) => finite_matrix(m, "mass_matrix")?,
@@ -489,6 +485,18 @@ fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
     if mass.cholesky().is_none() {
         return Err(err("mass_matrix", "is not positive definite".into()));
     }
+    Ok(mass)
+}
+
+fn parse_body(b: &BodyFile, k: usize) -> std::result::Result<Body, FieldErr> {
+    let err = |f: &str, m: String| (f.to_string(), m);
+    if b.name.trim().is_empty() {
+        return Err(err("name", format!("body {k} needs a non-empty name")));
+    }
+    if b.position.iter().any(|v| !v.is_finite()) {
+        return Err(err("position", "must be three finite numbers (m)".into()));
+    }
+    let mass = body_mass(b)?;
     let linear_damping = match &b.linear_damping {
         Some(m) => finite_matrix(m, "linear_damping")?,
         None => Matrix6::zeros(),

@@ -260,6 +260,96 @@ pub fn read_radiation_bounded<R: BufRead>(
     s: Scaling,
     bounds: &EntryBounds,
 ) -> Result<Radiation> {
+    let by_per = radiation_rows(reader, file, n_modes, s, bounds)?;
+    radiation_complete(file, n_modes, &by_per)?;
+    let mut rad = Radiation {
+        omega_rad_s: vec![],
+        added_mass: vec![],
+        damping: vec![],
+        added_mass_zero: None,
+        added_mass_inf: None,
+    };
+    let mut rows: Vec<_> = by_per.into_values().collect();
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (omega, a, b, _, _) in rows {
+        if omega == 0.0 {
+            rad.added_mass_zero = Some(a);
+        } else if omega.is_infinite() {
+            rad.added_mass_inf = Some(a);
+        } else {
+            rad.omega_rad_s.push(omega);
+            rad.added_mass.push(a);
+            rad.damping.push(b);
+        }
+    }
+    if rad.omega_rad_s.is_empty() {
+        return Err(Error::Invalid {
+            file: file.into(),
+            msg: "no finite frequency in the file (only PER = -1 / 0 rows)".into(),
+        });
+    }
+    Ok(rad)
+}
+
+/// Reads a `.3`-type file (`.3`, `.2`, `.3fk`, `.3sc`) for `n_modes` modes.
+pub fn read_excitation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scaling) -> Result<Excitation> {
+    read_excitation_bounded(reader, file, n_modes, s, &EntryBounds::none())
+}
+
+/// [`read_excitation`] with every entry within `bounds`.
+pub fn read_excitation_bounded<R: BufRead>(
+    reader: R,
+    file: &str,
+    n_modes: usize,
+    s: Scaling,
+    bounds: &EntryBounds,
+) -> Result<Excitation> {
+    let by_per = excitation_rows(reader, file, n_modes, s, bounds)?;
+    excitation_complete(file, n_modes, &by_per)?;
+    let mut pers: Vec<_> = by_per.into_values().collect();
+    pers.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut headings: Option<Vec<f64>> = None;
+    let mut exc = Excitation {
+        omega_rad_s: vec![],
+        heading_deg: vec![],
+        values: vec![],
+        n_modes,
+    };
+    for (omega, first_line, hmap) in pers {
+        let mut hs: Vec<(f64, Vec<Option<Complex64>>)> = hmap.into_values().collect();
+        hs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let these: Vec<f64> = hs.iter().map(|h| h.0).collect();
+        match &headings {
+            None => headings = Some(these.clone()),
+            Some(h0) if *h0 != these => {
+                return Err(Error::Invalid {
+                    file: file.into(),
+                    msg: format!(
+                        "period {:.6} s (first at line {first_line}) has headings {these:?} deg, but the first period has {h0:?}: every period must have the same headings",
+                        2.0 * PI / omega
+                    ),
+                });
+            }
+            _ => {}
+        }
+        exc.omega_rad_s.push(omega);
+        for (_, vals) in hs {
+            // modes absent from the file are zero (WAMIT omits modes it did not solve)
+            exc.values.extend(vals.into_iter().map(|v| v.unwrap_or_default()));
+        }
+    }
+    exc.heading_deg = headings.unwrap_or_default();
+    Ok(exc)
+}
+
+/// The `.1` file's rows by period, each entry scaled to SI and checked against `bounds`.
+fn radiation_rows<R: BufRead>(
+    reader: R,
+    file: &str,
+    n_modes: usize,
+    s: Scaling,
+    bounds: &EntryBounds,
+) -> Result<BTreeMap<u64, RadiationRows>> {
     // key: period bits (the same period prints identically on every row of a frequency)
     let mut by_per: BTreeMap<u64, RadiationRows> = BTreeMap::new();
     for (line, f) in data_lines(reader, file)? {
@@ -315,6 +405,11 @@ pub fn read_radiation_bounded<R: BufRead>(
             }
         }
     }
+    Ok(by_per)
+}
+
+/// Every positive period of a `.1` file lists the pairs the others list (else the file was cut short).
+fn radiation_complete(file: &str, n_modes: usize, by_per: &BTreeMap<u64, RadiationRows>) -> Result<()> {
     // every positive period lists the pairs the others list
     let mut union = vec![false; n_modes * n_modes];
     for (omega, _, _, seen, _) in by_per.values() {
@@ -340,48 +435,17 @@ pub fn read_radiation_bounded<R: BufRead>(
             });
         }
     }
-    let mut rad = Radiation {
-        omega_rad_s: vec![],
-        added_mass: vec![],
-        damping: vec![],
-        added_mass_zero: None,
-        added_mass_inf: None,
-    };
-    let mut rows: Vec<_> = by_per.into_values().collect();
-    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (omega, a, b, _, _) in rows {
-        if omega == 0.0 {
-            rad.added_mass_zero = Some(a);
-        } else if omega.is_infinite() {
-            rad.added_mass_inf = Some(a);
-        } else {
-            rad.omega_rad_s.push(omega);
-            rad.added_mass.push(a);
-            rad.damping.push(b);
-        }
-    }
-    if rad.omega_rad_s.is_empty() {
-        return Err(Error::Invalid {
-            file: file.into(),
-            msg: "no finite frequency in the file (only PER = -1 / 0 rows)".into(),
-        });
-    }
-    Ok(rad)
+    Ok(())
 }
 
-/// Reads a `.3`-type file (`.3`, `.2`, `.3fk`, `.3sc`) for `n_modes` modes.
-pub fn read_excitation<R: BufRead>(reader: R, file: &str, n_modes: usize, s: Scaling) -> Result<Excitation> {
-    read_excitation_bounded(reader, file, n_modes, s, &EntryBounds::none())
-}
-
-/// [`read_excitation`] with every entry within `bounds`.
-pub fn read_excitation_bounded<R: BufRead>(
+/// The `.3` file's rows by period and heading, each entry scaled to SI and checked against `bounds`.
+fn excitation_rows<R: BufRead>(
     reader: R,
     file: &str,
     n_modes: usize,
     s: Scaling,
     bounds: &EntryBounds,
-) -> Result<Excitation> {
+) -> Result<BTreeMap<u64, ExcitationRows>> {
     // period bits -> heading bits -> values
     let mut by_per: BTreeMap<u64, ExcitationRows> = BTreeMap::new();
     for (line, f) in data_lines(reader, file)? {
@@ -431,6 +495,12 @@ pub fn read_excitation_bounded<R: BufRead>(
         }
         h.1[i] = Some(x);
     }
+    Ok(by_per)
+}
+
+/// Every (period, heading) of a `.3` file lists the modes the others list (else the file was cut
+/// short).
+fn excitation_complete(file: &str, n_modes: usize, by_per: &BTreeMap<u64, ExcitationRows>) -> Result<()> {
     // every (period, heading) lists the modes the others list
     let mut union = vec![false; n_modes];
     for (_, _, hmap) in by_per.values() {
@@ -454,40 +524,7 @@ pub fn read_excitation_bounded<R: BufRead>(
             }
         }
     }
-    let mut pers: Vec<_> = by_per.into_values().collect();
-    pers.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut headings: Option<Vec<f64>> = None;
-    let mut exc = Excitation {
-        omega_rad_s: vec![],
-        heading_deg: vec![],
-        values: vec![],
-        n_modes,
-    };
-    for (omega, first_line, hmap) in pers {
-        let mut hs: Vec<(f64, Vec<Option<Complex64>>)> = hmap.into_values().collect();
-        hs.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let these: Vec<f64> = hs.iter().map(|h| h.0).collect();
-        match &headings {
-            None => headings = Some(these.clone()),
-            Some(h0) if *h0 != these => {
-                return Err(Error::Invalid {
-                    file: file.into(),
-                    msg: format!(
-                        "period {:.6} s (first at line {first_line}) has headings {these:?} deg, but the first period has {h0:?}: every period must have the same headings",
-                        2.0 * PI / omega
-                    ),
-                });
-            }
-            _ => {}
-        }
-        exc.omega_rad_s.push(omega);
-        for (_, vals) in hs {
-            // modes absent from the file are zero (WAMIT omits modes it did not solve)
-            exc.values.extend(vals.into_iter().map(|v| v.unwrap_or_default()));
-        }
-    }
-    exc.heading_deg = headings.unwrap_or_default();
-    Ok(exc)
+    Ok(())
 }
 
 /// Reads a `.hst` file: the linear restoring matrix (N/m, N, N m/rad ...).

@@ -439,6 +439,43 @@ pub struct TailFit {
 /// Near exponents the fit tries for a DOF whose data ask for less damping than the cubic tail.
 const NEAR_POWERS: [f64; 9] = [3.0, 3.5, 4.0, 5.0, 6.0, 8.0, 10.0, 13.0, 16.0];
 
+/// The far part never lifts the tail above the data's last damping: B_N r^3 + D r^2 (1 - r) <= B_N
+/// for r = w_N/w in (0, 1] needs D_ii <= TAIL_FAR_CAP B_N,ii; enforced by the congruence S D S (S
+/// diagonal, so D stays PSD). Without it a database whose A_inf is off by a constant (WEC-Sim's RM3)
+/// makes the fit invent a damping bump orders of magnitude above its last value.
+fn capped_far(far: &DMatrix<f64>, cubic: &DampingTail) -> DMatrix<f64> {
+    let n = far.nrows();
+    let cap: Vec<f64> = (0..n)
+        .map(|i| {
+            let (d, b) = (far[(i, i)], TAIL_FAR_CAP * cubic.b_n[(i, i)].max(0.0));
+            if d > b { (b / d).sqrt() } else { 1.0 }
+        })
+        .collect();
+    DMatrix::from_fn(n, n, |i, j| cap[i] * far[(i, j)] * cap[j])
+}
+
+/// Per DOF, the near exponent of [`NEAR_POWERS`] whose added-mass image (`images`, in that order) best
+/// fits its diagonal residual `r0`, for the DOFs whose data ask for less damping above w_N (not
+/// `wants`); the cubic's [`TAIL_POWER`] for the others.
+fn near_powers(r0: &[DMatrix<f64>], images: &[Vec<f64>], wants: &[bool], cubic: &DampingTail) -> Vec<f64> {
+    (0..wants.len())
+        .map(|i| {
+            let b = cubic.b_n[(i, i)];
+            if wants[i] || b <= 0.0 {
+                return TAIL_POWER as f64;
+            }
+            let misfit = |g: &[f64]| -> f64 { r0.iter().zip(g).map(|(r, gk)| (r[(i, i)] - b * gk).powi(2)).sum() };
+            NEAR_POWERS
+                .iter()
+                .zip(images)
+                .map(|(p, g)| (*p, misfit(g)))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .map(|(p, _)| p)
+                .unwrap_or(TAIL_POWER as f64)
+        })
+        .collect()
+}
+
 /// Fits the damping tail so that the added mass implied by K, A_inf - (1/w) int K sin, matches the
 /// database's `added_mass` in the band w <= KK_BAND_FRACTION w_N given the BEM's `a_inf`:
 /// 1. with the cubic tail, the residual r_ij(w) = (Ogilvie estimate - A_inf)_ij (symmetric parts);
@@ -509,38 +546,13 @@ pub fn fit_tail(
     } else {
         DMatrix::zeros(n, n)
     };
-    // the far part never lifts the tail above the data's last damping: B_N r^3 + D r^2 (1 - r) <= B_N
-    // for r = w_N/w in (0, 1] needs D_ii <= TAIL_FAR_CAP B_N,ii; enforced by the congruence S D S (S
-    // diagonal, so D stays PSD). Without it a database whose A_inf is off by a constant (WEC-Sim's RM3)
-    // makes the fit invent a damping bump orders of magnitude above its last value
-    let cap: Vec<f64> = (0..n)
-        .map(|i| {
-            let (d, b) = (far[(i, i)], TAIL_FAR_CAP * cubic.b_n[(i, i)].max(0.0));
-            if d > b { (b / d).sqrt() } else { 1.0 }
-        })
-        .collect();
-    let far = DMatrix::from_fn(n, n, |i, j| cap[i] * far[(i, j)] * cap[j]);
+    let far = capped_far(&far, &cubic);
     // near exponents for the DOFs that ask for less damping: B_N,ii (r^p - r^3) has image g_p
     let images: Vec<Vec<f64>> = NEAR_POWERS
         .iter()
         .map(|&p| image(&|x: f64| (wn / x).powf(p) - (wn / x).powi(TAIL_POWER)))
         .collect();
-    let near_power: Vec<f64> = (0..n)
-        .map(|i| {
-            let b = cubic.b_n[(i, i)];
-            if wants[i] || b <= 0.0 {
-                return TAIL_POWER as f64;
-            }
-            let misfit = |g: &[f64]| -> f64 { r0.iter().zip(g).map(|(r, gk)| (r[(i, i)] - b * gk).powi(2)).sum() };
-            NEAR_POWERS
-                .iter()
-                .zip(&images)
-                .map(|(p, g)| (*p, misfit(g)))
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .map(|(p, _)| p)
-                .unwrap_or(TAIL_POWER as f64)
-        })
-        .collect();
+    let near_power = near_powers(&r0, &images, &wants, &cubic);
     let tail = DampingTail {
         near_power,
         far,

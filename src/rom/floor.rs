@@ -8,7 +8,7 @@
 //! Conventions: RAO tables are indexed `[heading][frequency][state]` (6N body modes then the tanks,
 //! inactive states zero), exp(+i w t), per metre of wave amplitude (DESIGN.md section 1).
 //!
-//! The metric (the issue's, and the integration tests'): for each (state, heading) curve, the worst
+//! The metric (the validation's and the integration tests'): for each (state, heading) curve, the worst
 //! |test - reference| over the frequencies divided by that curve's reference peak; a curve whose peak is
 //! below [`SMALL_CURVE`] of the same state's largest peak over every heading (it vanishes by symmetry,
 //! like pitch in beam seas) is divided by that largest peak instead.

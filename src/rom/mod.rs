@@ -28,6 +28,7 @@
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
 
+mod build;
 pub mod dense;
 pub mod drift;
 pub mod floor;
@@ -39,7 +40,6 @@ pub mod sinusoids;
 pub mod step;
 pub mod stepper;
 
-pub use crate::radiation::history::Memory;
 pub use forecast::{Forecast, ForecastRequest, Forecaster, Track};
 pub use model::{OptionError, RadiationMethod, RomOptions, TimeModel};
 

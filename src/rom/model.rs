@@ -265,7 +265,7 @@ fn state_space_kernel(
     let di = step.instantaneous();
     let mut d = DMatrix::zeros(n, n);
     d.view_mut((0, 0), (nh, nh)).copy_from(&di);
-    // passivity cover: constant damping where the fit's Re K dips below zero (see hydro::statespace)
+    // passivity cover: constant damping where the fit's Re K dips below zero (see radiation::statespace)
     for i in 0..nh {
         damping[(i, i)] += model.cover * model.scale[i];
     }
@@ -281,8 +281,56 @@ fn state_space_kernel(
     ))
 }
 
+/// The radiation memory a model of `opts` runs, sampled where it is fitted: the convolution samples K
+/// at the solver's step; the state-space model is fitted once per database (and speed) on the system
+/// file's IRF grid (`irf.dt_s`), so it, its tail and its A_inf do not move with the solver's step (a
+/// fit at each step would move the model's floor with dt). The IRF is from passive damping and the
+/// damping tail.
+fn sampled_memory(sys: &VesselSystem, opts: &RomOptions) -> Result<RadiationMemory> {
+    let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
+    // the grids K is sampled on: the solver's (convolution) and the system file's (state-space fit)
+    let grid_dt = match opts.radiation {
+        RadiationMethod::StateSpace => sys.spec.irf.dt_s,
+        _ => opts.dt_s,
+    };
+    irf::check_grid(grid_dt, memory_s).map_err(|e| OptionError {
+        field: e.field(),
+        msg: e.to_string(),
+    })?;
+    Ok(match opts.radiation {
+        RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
+        _ => radiation_memory(sys, opts.dt_s, memory_s),
+    })
+}
+
+/// The inverses of the implicit step's matrix S = M + B dt / 2 + C beta dt^2 (`damping`: B with the
+/// instantaneous radiation damping) and of the mass M (+ A_inf), which must be positive definite.
+fn step_inverses(
+    mass: &DMatrix<f64>,
+    damping: &DMatrix<f64>,
+    stiffness: &DMatrix<f64>,
+    opts: &RomOptions,
+) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
+    let dt = opts.dt_s;
+    let s = mass + damping * (dt / 2.0) + stiffness * (opts.beta * dt * dt);
+    let s_inv = s
+        .try_inverse()
+        .ok_or_else(|| Error::Input("the implicit step matrix is singular (no mass on an active DOF?)".into()))?;
+    let mass_inv = mass
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| Error::Input("the mass matrix M + A_inf is singular".into()))?;
+    if mass.clone().cholesky().is_none() {
+        return Err(Error::Input(
+            "M + A_inf (with the tanks' fluid) is not positive definite: check the tank coefficients a_tt, a_t4".into(),
+        ));
+    }
+    Ok((s_inv, mass_inv))
+}
+
 impl TimeModel {
-    pub fn new(sys: &VesselSystem, opts: RomOptions) -> Result<TimeModel> {
+    /// The model of `sys` with `opts`, assembled; [`TimeModel::new`] (`rom/build.rs`) checks it.
+    pub(super) fn assemble(sys: &VesselSystem, opts: RomOptions) -> Result<TimeModel> {
         opts.validate()?;
         let active = sys.active_states();
         let nh = sys.active_indices().len();
@@ -299,24 +347,7 @@ impl TimeModel {
         let sub = |m: &DMatrix<f64>| DMatrix::from_fn(n, n, |r, c| m[(active[r], active[c])]);
         let dt = opts.dt_s;
         let u = opts.speed_m_s;
-        // the IRF from passive damping and the damping tail, fitted where it is sampled: the convolution
-        // samples K at the solver's step; the state-space model is fitted once per database (and speed)
-        // on the system file's IRF grid (`irf.dt_s`), so it, its tail and its A_inf do not move with the
-        // solver's step (a fit at each step would move the model's floor with dt)
-        let memory_s = opts.memory_s.unwrap_or_else(|| memory_duration_s(sys));
-        // the grids K is sampled on: the solver's (convolution) and the system file's (state-space fit)
-        let grid_dt = match opts.radiation {
-            RadiationMethod::StateSpace => sys.spec.irf.dt_s,
-            _ => dt,
-        };
-        irf::check_grid(grid_dt, memory_s).map_err(|e| OptionError {
-            field: e.field(),
-            msg: e.to_string(),
-        })?;
-        let RadiationMemory { irf: irf_all, tail, .. } = match opts.radiation {
-            RadiationMethod::StateSpace => state_space_memory(sys, memory_s),
-            _ => radiation_memory(sys, dt, memory_s),
-        };
+        let RadiationMemory { irf: irf_all, tail, .. } = sampled_memory(sys, &opts)?;
         // A_inf: Ogilvie's estimate from the same K unless the system file insists on the database's
         // (Ogilvie's is consistent with the K the model runs, so its floor is the closer one)
         let a_inf_all = model_a_inf(sys, &irf_all);
@@ -345,22 +376,9 @@ impl TimeModel {
             RadiationMethod::Convolution => convolution_kernel(&irf_all, &hyd, n, dt),
             RadiationMethod::StateSpace => state_space_kernel(sys, &a_inf_all, &tail, &opts, n, &mut damping)?,
         };
-        let s = &mass + (&damping + &d_inst) * (dt / 2.0) + &stiffness * (opts.beta * dt * dt);
-        let s_inv = s
-            .try_inverse()
-            .ok_or_else(|| Error::Input("the implicit step matrix is singular (no mass on an active DOF?)".into()))?;
+        let (s_inv, mass_inv) = step_inverses(&mass, &(&damping + &d_inst), &stiffness, &opts)?;
         // the convolution's IRF for the implied frequency response (active DOFs, unweighted)
         let irf = matches!(opts.radiation, RadiationMethod::Convolution).then(|| active_irf(&irf_all, &hyd, n, dt));
-        let mass_inv = mass
-            .clone()
-            .try_inverse()
-            .ok_or_else(|| Error::Input("the mass matrix M + A_inf is singular".into()))?;
-        if mass.clone().cholesky().is_none() {
-            return Err(Error::Input(
-                "M + A_inf (with the tanks' fluid) is not positive definite: check the tank coefficients a_tt, a_t4"
-                    .into(),
-            ));
-        }
         let external = sys.spec.external.has_nonlinear().then(|| sys.spec.external.clone());
         let stiffness_linearized = &stiffness + sub(&sys.spec.external.nonlinear_tangent(sys.n_states()));
         let drift_modes = super::drift::drift_modes(&mass, &stiffness_linearized);
@@ -397,64 +415,7 @@ impl TimeModel {
             water_depth_m: sys.spec.water_depth_m,
             irf,
         };
-        if sys.spec.irf.passivity == crate::hydro::system::Passivity::None {
-            model.check_free_motion()?;
-        }
         Ok(model)
-    }
-
-    /// With the database's damping used as it is (`irf.passivity = "none"`), a radiation memory that
-    /// creates energy can make the free motion grow. From a small velocity on every active state, no
-    /// waves, over the memory's length (at least 60 s): Err when the energy (v^T M v + x^T C x) / 2 over
-    /// the run's last quarter exceeds [`FREE_MOTION_GROWTH`] times its start.
-    fn check_free_motion(&self) -> Result<()> {
-        let n = self.n();
-        let v0: Vec<f64> = (0..n).map(|r| 0.01 / (1.0 + r as f64)).collect();
-        let x0 = vec![0.0; n];
-        let memory = crate::radiation::history::Memory::new(self);
-        let memory_s = match &self.kernel {
-            Kernel::Convolution { taps, .. } => *taps as f64 * self.opts.dt_s,
-            Kernel::StateSpace { .. } => 300.0,
-        };
-        let length_s = memory_s.clamp(60.0, 600.0);
-        let mut fc = super::forecast::Forecaster::new();
-        let req = super::forecast::ForecastRequest {
-            x0: &x0,
-            v0: &v0,
-            memory: &memory,
-            waves: &[],
-            length_s,
-            ramp_s: 0.0,
-            drift_velocity: None,
-            track: None,
-        };
-        let refuse = |why: String| {
-            Error::Input(format!(
-                "irf.passivity = \"none\": {why}: the database's damping creates energy (not positive semi-definite); use passivity = \"project\""
-            ))
-        };
-        let f = fc
-            .forecast(self, &req)
-            .map_err(|e| refuse(format!("the free motion diverged ({e})")))?;
-        let energy = |k: usize| {
-            let (mut e, nm) = (0.0, self.n_modes);
-            for (r, &i) in self.active.iter().enumerate() {
-                for (c, &j) in self.active.iter().enumerate() {
-                    e += 0.5 * self.mass[(r, c)] * f.v[k * nm + i] * f.v[k * nm + j];
-                    e += 0.5 * self.stiffness_linearized[(r, c)] * f.x[k * nm + i] * f.x[k * nm + j];
-                }
-            }
-            e
-        };
-        let start = energy(0);
-        let late = (3 * f.steps / 4..=f.steps).map(energy).fold(0.0, f64::max);
-        if late.is_nan() || late > FREE_MOTION_GROWTH * start {
-            return Err(refuse(format!(
-                "the free motion's energy grew {:.3e} times in {length_s:.0} s",
-                late / start
-            )));
-        }
-        Ok(())
     }
 
     /// K(i w) = B(w) + i w (A(w) - A_inf) of the model's own radiation memory (active DOFs): the

@@ -3,10 +3,8 @@
 //!
 //! Why this many steps: the Newmark average-acceleration step (`rom::stepper`) keeps amplitude but
 //! lengthens a period T by about (w dt)^2 / 12 at step dt; near a lightly damped resonance that moves
-//! the response by several times as much. A 24 x 8 x 3 m box barge (pitch 4.5 s) is 3.3 % of a curve's
-//! peak off its BEM RAO at 0.1 s (45 steps a period), 0.77 % at 0.05 s (90) and 0.31 % at 0.025 s,
-//! against a floor of 0.26 % (issue 27's figures). [`STEPS_PER_PERIOD`] steps keep the step's own error
-//! well below 1 % of peak.
+//! the response by several times as much. [`STEPS_PER_PERIOD`] steps keep the step's own error well
+//! below 1 % of a curve's peak (docs/validation.md has the measured error against the step).
 
 use crate::hydro::VesselSystem;
 

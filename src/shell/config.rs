@@ -5,11 +5,15 @@
 pub use crate::settings::*;
 use std::path::Path;
 
+/// `SHIPCAST_FAULT=compute-panic` makes the daemon's compute thread panic on its first job: fault
+/// injection for the test of the daemon's liveness (a panic there ends the daemon with an error).
+pub const FAULT_ENV: &str = "SHIPCAST_FAULT";
+
 /// The environment variables that overlay the file: `SHIPCAST_<SECTION>__<KEY>` (e.g.
-/// `SHIPCAST_FORECAST__PERIOD_S=0.5`). `SHIPCAST_CONFIG` (the file's path, read by the CLI) and
-/// `SHIPCAST_LOG` are not keys and are left out.
+/// `SHIPCAST_FORECAST__PERIOD_S=0.5`). `SHIPCAST_CONFIG` (the file's path, read by the CLI),
+/// `SHIPCAST_LOG` and [`FAULT_ENV`] are not keys and are left out.
 pub const ENV_PREFIX: &str = "SHIPCAST_";
-const ENV_NOT_KEYS: [&str; 3] = ["SHIPCAST_CONFIG", "SHIPCAST_LOG", crate::shell::daemon::FAULT_ENV];
+const ENV_NOT_KEYS: [&str; 3] = ["SHIPCAST_CONFIG", "SHIPCAST_LOG", FAULT_ENV];
 
 /// Reads the file, overlays the `SHIPCAST_*` variables of `env` (name, value), validates. An error in
 /// the file names the file; an error an environment variable brings in names that variable.
@@ -271,12 +275,28 @@ pub fn bound(key: &str) -> Option<&'static Bound> {
     BOUNDS.iter().find(|b| b.key == key)
 }
 
+/// A numeric key of the table: (bound key, key as named, value; `None`: not set).
+type Number = (&'static str, String, Option<f64>);
+
+/// A key named as its bound, set to `v`.
+fn one(k: &'static str, v: f64) -> Number {
+    (k, k.to_string(), Some(v))
+}
+
 /// Every numeric key of the table with its value (`None`: not set), as (bound key, key as named).
 fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
+    let mut out = site_and_forecast_numbers(c);
+    out.extend(estimator_link_record_numbers(c));
+    out.extend(simulate_numbers(c));
+    out.extend(simulate_sensor_numbers(c));
+    out.extend(operation_console_numbers(c));
+    out
+}
+
+/// The numeric keys of `[site]` and `[forecast]`, in the table's order.
+fn site_and_forecast_numbers(c: &ShipcastConfig) -> Vec<Number> {
     let f = &c.forecast;
-    let s = &c.simulate;
-    let one = |k: &'static str, v: f64| (k, k.to_string(), Some(v));
-    let mut out = vec![
+    vec![
         one("site.origin_east_m", c.site.origin_east_m),
         one("site.origin_north_m", c.site.origin_north_m),
         one("site.heading_deg", c.site.heading_deg),
@@ -303,6 +323,12 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("forecast.radar_snapshots", f.radar_snapshots as f64),
         one("forecast.model_error", f.model_error),
         one("forecast.trusted_nrmse", f.trusted_nrmse),
+    ]
+}
+
+/// The numeric keys of `[estimator]`, `[link]` and `[record]`, in the table's order.
+fn estimator_link_record_numbers(c: &ShipcastConfig) -> Vec<Number> {
+    vec![
         one("estimator.noise_m", c.estimator.noise_m),
         one("estimator.noise_rad", c.estimator.noise_rad),
         one("estimator.velocity_noise_m_s", c.estimator.velocity_noise_m_s),
@@ -319,6 +345,13 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("estimator.drift_time_s", c.estimator.drift_time_s),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
+    ]
+}
+
+/// The numeric keys of `[simulate]` itself and of `[simulate.sea]`, in the table's order.
+fn simulate_numbers(c: &ShipcastConfig) -> Vec<Number> {
+    let s = &c.simulate;
+    vec![
         one("simulate.duration_s", s.duration_s),
         one("simulate.speed", s.speed),
         one("simulate.damping_factor", s.damping_factor),
@@ -336,6 +369,14 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.sea.components", s.sea.components as f64),
         one("simulate.sea.omega_min_rad_s", s.sea.omega_min_rad_s),
         one("simulate.sea.omega_max_rad_s", s.sea.omega_max_rad_s),
+    ]
+}
+
+/// The numeric keys of the simulated sensors and track (`[simulate.radar]`, `.imu`, `.track`,
+/// `.navigation`), in the table's order.
+fn simulate_sensor_numbers(c: &ShipcastConfig) -> Vec<Number> {
+    let s = &c.simulate;
+    vec![
         one("simulate.radar.radius_m", s.radar.radius_m),
         one("simulate.radar.cells", s.radar.cells as f64),
         one("simulate.radar.period_s", s.radar.period_s),
@@ -363,6 +404,13 @@ fn numbers(c: &ShipcastConfig) -> Vec<(&'static str, String, Option<f64>)> {
         one("simulate.navigation.rate_hz", s.navigation.rate_hz),
         one("simulate.navigation.heading_noise_deg", s.navigation.heading_noise_deg),
         one("simulate.navigation.position_noise_m", s.navigation.position_noise_m),
+    ]
+}
+
+/// The numeric keys of `[operation]` and `[console]`, then each operation channel's limit, in the
+/// table's order.
+fn operation_console_numbers(c: &ShipcastConfig) -> Vec<Number> {
+    let mut out = vec![
         one("operation.duration_s", c.operation.duration_s),
         one("operation.confidence", c.operation.confidence),
         one("console.history_s", c.console.history_s),
@@ -439,6 +487,27 @@ fn toml_key_at(text: &str, offset: usize) -> (String, usize) {
 }
 
 fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
+    check_bounds(c)?;
+    check_forecast(c)?;
+    check_simulate_radar(c)?;
+    check_log_and_ipc(c)?;
+    check_link(c)?;
+    c.console.colours.parse()?;
+    let sea = &c.simulate.sea;
+    if sea.omega_min_rad_s >= sea.omega_max_rad_s {
+        return Err((
+            "simulate.sea.omega_max_rad_s".into(),
+            format!(
+                "must be above simulate.sea.omega_min_rad_s ({} rad/s), found {}",
+                sea.omega_min_rad_s, sea.omega_max_rad_s
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Every numeric key that is set is within its bound ([`BOUNDS`]); the error names the first that is not.
+fn check_bounds(c: &ShipcastConfig) -> Result<(), (String, String)> {
     for (bkey, key, v) in numbers(c) {
         let (Some(v), Some(b)) = (v, bound(bkey)) else {
             continue;
@@ -447,6 +516,12 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             return Err((key, format!("must be in {}, found {v:?}", b.range())));
         }
     }
+    Ok(())
+}
+
+/// `[forecast]`: the model's options, the number of steps of the horizon, the wave ages' order and
+/// the radiation's name.
+fn check_forecast(c: &ShipcastConfig) -> Result<(), (String, String)> {
     let f = &c.forecast;
     // the default step is the system's (known once it is loaded): the longest it can be stands in
     crate::engine::options_at(c, f.dt_s.unwrap_or(crate::rom::step::MAX_DEFAULT_DT_S))
@@ -480,6 +555,11 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             format!("expected \"convolution\" or \"state-space\", found \"{}\"", f.radiation),
         ));
     }
+    Ok(())
+}
+
+/// `[simulate.radar]`: the output's name and the masked sector's bearings.
+fn check_simulate_radar(c: &ShipcastConfig) -> Result<(), (String, String)> {
     if !["components", "grid"].contains(&c.simulate.radar.output.as_str()) {
         return Err((
             "simulate.radar.output".into(),
@@ -497,6 +577,11 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
             format!("two relative bearings in [-360, 360] deg, found {m:?}"),
         ));
     }
+    Ok(())
+}
+
+/// `[log]`'s format and level, and `[ipc]`'s service prefix.
+fn check_log_and_ipc(c: &ShipcastConfig) -> Result<(), (String, String)> {
     if !["human", "json"].contains(&c.log.format.as_str()) {
         return Err((
             "log.format".into(),
@@ -508,6 +593,11 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         return Err(("ipc.service_prefix".into(), "must be 1..200 characters".into()));
     }
     check_service_prefix(&c.ipc.service_prefix).map_err(|m| ("ipc.service_prefix".to_string(), m))?;
+    Ok(())
+}
+
+/// `[link]`: its name and namespace, the other ship's prefix (not this ship's) and this ship's vessels.
+fn check_link(c: &ShipcastConfig) -> Result<(), (String, String)> {
     check_key_chunk(&c.link.name).map_err(|m| ("link.name".to_string(), m))?;
     check_key_chunk(&c.link.namespace).map_err(|m| ("link.namespace".to_string(), m))?;
     if !c.link.peer_prefix.is_empty() {
@@ -531,17 +621,6 @@ fn validate(c: &ShipcastConfig) -> Result<(), (String, String)> {
         return Err((
             "link.own_vessels".into(),
             format!("vessel {v}: indices 0..{}", crate::shell::ipc::wire::MAX_VESSELS),
-        ));
-    }
-    c.console.colours.parse()?;
-    let sea = &c.simulate.sea;
-    if sea.omega_min_rad_s >= sea.omega_max_rad_s {
-        return Err((
-            "simulate.sea.omega_max_rad_s".into(),
-            format!(
-                "must be above simulate.sea.omega_min_rad_s ({} rad/s), found {}",
-                sea.omega_min_rad_s, sea.omega_max_rad_s
-            ),
         ));
     }
     Ok(())

@@ -31,9 +31,7 @@ pub fn wall_s() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// `SHIPCAST_FAULT=compute-panic` makes the compute thread panic on its first job: fault injection for
-/// the test of the daemon's liveness (a panic there ends the daemon with an error).
-pub const FAULT_ENV: &str = "SHIPCAST_FAULT";
+pub use crate::shell::config::FAULT_ENV;
 
 fn compute_thread(
     mut computer: Computer,

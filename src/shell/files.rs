@@ -1,5 +1,5 @@
 //! Shell: reads a system file and its WAMIT database from disk and hands the text to the pure readers.
-//! The only module of the library that touches the file system.
+//! (Logs are `record`'s, configurations `config`'s.)
 
 use crate::hydro::system::SystemSpec;
 use crate::hydro::wamit::{self, Scaling};

@@ -42,7 +42,7 @@
 //! Version 1 logs (before JSON Schemas, metadata and `/radar`; the simulator's log times from 0) are
 //! read as they are.
 
-use crate::shell::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
+use crate::engine::message::{ForecastHeader, MotionSample, NavigationSample, SCHEMA_VERSION};
 use crate::waves::field::{FlatHeader, WaveField, coverage_from_sectors};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -51,9 +51,9 @@ use std::io::{BufWriter, Seek, Write};
 use std::path::Path;
 
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
-/// it reads this and every older one. 2: JSON Schemas, UNIX log times, the `shipcast` metadata record,
-/// `/radar`; 3: `/navigation`, `/elevation`; 4: a forecast's `sigma` and `trusted_from_s`, a wave
-/// field's `window_s`.
+/// it reads this and every older one. What each version added: 2, JSON Schemas, UNIX log times, the
+/// `shipcast` metadata record, `/radar`; 3, `/navigation`, `/elevation`; 4, a forecast's `sigma` and
+/// `trusted_from_s`, a wave field's `window_s`; 5, a wave field's `inner_m` and `coverage_ranges_m`.
 pub const LOG_SCHEMA_VERSION: u32 = 5;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
@@ -489,7 +489,7 @@ const FOXGLOVE_FLOAT32: u32 = 7;
 
 impl GridRecord {
     /// A radar scan (its grid's corner and turn in `pose`; NaN cells kept).
-    pub fn of_scan(scan: &crate::shell::ipc::Scan) -> GridRecord {
+    pub fn of_scan(scan: &crate::engine::message::Scan) -> GridRecord {
         let g = &scan.grid;
         let local: Vec<f64> = g.x_m.iter().map(|x| x - g.x_m[0]).collect();
         let mut r = GridRecord::elevation(
@@ -520,7 +520,7 @@ impl GridRecord {
 
     /// The scan of a `/elevation` record (the inverse of [`Self::of_scan`]): one FLOAT32 field, a turn
     /// about z only.
-    pub fn scan(&self) -> Result<crate::shell::ipc::Scan, String> {
+    pub fn scan(&self) -> Result<crate::engine::message::Scan, String> {
         use base64::Engine;
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(&self.data)
@@ -543,7 +543,7 @@ impl GridRecord {
             orientation_rad: theta,
         };
         let origin = frame.to_earth(0.5 * dx, 0.5 * dy);
-        Ok(crate::shell::ipc::Scan {
+        Ok(crate::engine::message::Scan {
             grid: crate::waves::observe::Grid {
                 x_m: (0..nx).map(|i| i as f64 * dx).collect(),
                 y_m: (0..ny).map(|i| i as f64 * dy).collect(),

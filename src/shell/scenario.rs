@@ -5,7 +5,8 @@
 //! predictable horizon). The past is simulated by the reference (direct convolution) whatever method
 //! forecasts, as a measured past would not depend on it: the methods then differ only by their forecasts.
 
-use crate::rom::{self, ForecastRequest, Forecaster, Memory, RadiationMethod, RomOptions, TimeModel};
+use crate::radiation::history::Memory;
+use crate::rom::{self, ForecastRequest, Forecaster, RadiationMethod, RomOptions, TimeModel};
 use crate::shell::files;
 use crate::waves::WaveComponent;
 use crate::waves::sea::{self, SeaState, Spreading};

@@ -474,8 +474,8 @@ mod tests {
                 at_m: [100.0, -50.0],
                 window_s: 120.0,
             },
-            // a radar's view: a blind zone, a masked sector, shadows (fails before issue 28's
-            // coverage on the wire: read back as the disc of its farthest reach)
+            // a radar's view: a blind zone, a masked sector, shadows (not read back as the disc of
+            // its farthest reach)
             Region::Coverage {
                 centre_m: [100.0, -50.0],
                 inner_m: 190.0,

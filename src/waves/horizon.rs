@@ -256,18 +256,17 @@ mod tests {
         assert_eq!(disc_span([2000.0, 0.0], 1000.0, [5.0, 0.0])[1], 0.0);
     }
 
-    #[test]
-    fn known_leads_of_a_disc_a_probe_and_a_coverage() {
-        use crate::waves::field::{COVERAGE_SECTORS, FieldComponent};
+    /// A field of one component of 0.6 rad/s travelling west (towards -x) observed over `region`, and
+    /// its group speed, m/s.
+    fn westward(region: Region) -> (WaveField, f64) {
+        use crate::waves::field::FieldComponent;
         let w = 0.6;
-        let cg = group_velocity(w, 9.81, None);
-        // waves travelling west (towards -x)
         let comp = FieldComponent {
             omega_rad_s: w,
             direction_rad: PI,
             amplitude_m: num_complex::Complex64::new(1.0, 0.0),
         };
-        let field = |region| WaveField {
+        let field = WaveField {
             components: vec![comp],
             reference_m: [0.0, 0.0],
             time_s: 0.0,
@@ -275,6 +274,13 @@ mod tests {
             depth_m: None,
             region,
         };
+        (field, group_velocity(w, 9.81, None))
+    }
+
+    #[test]
+    fn known_leads_of_a_disc() {
+        let field = |region| westward(region).0;
+        let cg = westward(Region::Everywhere).1;
         // a disc of 1000 m around a stationary vessel at its centre: known from 0 to R / c_g
         let k = known_leads(
             &field(Region::Disc {
@@ -298,6 +304,12 @@ mod tests {
             (k[0][0] - 500.0 / cg).abs() < 1e-9 && (k[0][1] - 2500.0 / cg).abs() < 1e-9,
             "{k:?}"
         );
+    }
+
+    #[test]
+    fn known_leads_of_a_probe() {
+        let field = |region| westward(region).0;
+        let cg = westward(Region::Everywhere).1;
         // a probe 600 m up-wave that fitted 30 s: the groups passing it arrive 600 / c_g later
         let probe = |window_s| {
             field(Region::Point {
@@ -324,6 +336,13 @@ mod tests {
             [0.0, 0.0],
         );
         assert_eq!(k[0], [0.0, 0.0]);
+    }
+
+    #[test]
+    fn known_leads_of_a_coverage() {
+        use crate::waves::field::COVERAGE_SECTORS;
+        let field = |region| westward(region).0;
+        let cg = westward(Region::Everywhere).1;
         // a coverage of 1000 m in every sector: as the disc, to a step
         let cov = Region::Coverage {
             centre_m: [0.0, 0.0],

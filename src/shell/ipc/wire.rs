@@ -21,7 +21,7 @@
 //!   farthest point observed in each of `n_sectors` sectors of direction (m).
 //! - `forecast`: a slice of f64 with a [`ForecastHeader`]: series-major, series s = 6 v + d (vessel v,
 //!   DOF d), `steps + 1` displacements each at t = issue_time_s + k dt_s (m or rad); then as many
-//!   standard deviations, same order (the forecast's band: `rom::spread`). Schema version
+//!   standard deviations, same order (the forecast's band: `crate::band`). Schema version
 //!   [`FORECAST_SCHEMA_VERSION`].
 //! - `status`: [`Status`].
 //! - `link`: [`LinkStatus`], from `shipcast link` (the ship-to-ship link), when one runs.
@@ -126,7 +126,7 @@ impl WaveHeader {
 // references; its layout is the one `layouts_are_what_the_docs_say` checks.
 unsafe impl ZeroCopySend for MotionSample {
     unsafe fn type_name() -> &'static str {
-        "shipcast_MotionSample_v1"
+        MotionSample::TYPE_NAME
     }
 }
 
@@ -134,7 +134,7 @@ unsafe impl ZeroCopySend for MotionSample {
 // references; its layout is the one `layouts_are_what_the_docs_say` checks.
 unsafe impl ZeroCopySend for NavigationSample {
     unsafe fn type_name() -> &'static str {
-        "shipcast_NavigationSample_v1"
+        NavigationSample::TYPE_NAME
     }
 }
 
@@ -142,7 +142,7 @@ unsafe impl ZeroCopySend for NavigationSample {
 // references; its layout is the one `layouts_are_what_the_docs_say` checks.
 unsafe impl ZeroCopySend for ForecastHeader {
     unsafe fn type_name() -> &'static str {
-        "shipcast_ForecastHeader_v2"
+        ForecastHeader::TYPE_NAME
     }
 }
 
@@ -150,7 +150,7 @@ unsafe impl ZeroCopySend for ForecastHeader {
 // references; its layout is the one `layouts_are_what_the_docs_say` checks.
 unsafe impl ZeroCopySend for Status {
     unsafe fn type_name() -> &'static str {
-        "shipcast_Status_v4"
+        Status::TYPE_NAME
     }
 }
 
@@ -158,7 +158,7 @@ unsafe impl ZeroCopySend for Status {
 // references; its layout is the one `layouts_are_what_the_docs_say` checks.
 unsafe impl ZeroCopySend for LinkStatus {
     unsafe fn type_name() -> &'static str {
-        "shipcast_LinkStatus_v1"
+        LinkStatus::TYPE_NAME
     }
 }
 
