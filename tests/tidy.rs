@@ -170,38 +170,63 @@ fn named_modules(text: &str, module: &[String], is_bin: bool) -> Vec<Vec<String>
                     vec![]
                 }
             };
-            out.push(base.into_iter().chain(segs).collect());
+            let path: Vec<String> = base.into_iter().chain(segs).collect();
+            // a group (`crate::band::{ResponseTable, spread}`) names each of its items
+            let after = &code[start + rest.len()..];
+            match after.strip_prefix('{').and_then(|g| group_items(g)) {
+                Some(items) => out.extend(items.into_iter().map(|i| path.iter().cloned().chain(i).collect())),
+                None => out.push(path),
+            }
         }
     }
     out
 }
 
-/// The circles among `files` (module path -> the module paths it names): each a list of modules,
-/// found by following names between modules of which neither is inside the other.
-fn circles(files: &BTreeMap<Vec<String>, Vec<Vec<String>>>) -> Vec<Vec<String>> {
-    let file_of = |path: &[String]| -> Option<Vec<String>> {
-        (1..=path.len())
-            .rev()
-            .map(|k| path[..k].to_vec())
-            .find(|p| files.contains_key(p))
-    };
-    let related = |a: &[String], b: &[String]| a.starts_with(b) || b.starts_with(a);
-    let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
-    for (m, named) in files {
-        let to = named
-            .iter()
-            .filter_map(|n| file_of(n))
-            .filter(|t| !related(m, t))
-            .collect();
-        edges.insert(m.clone(), to);
+/// The items of a `use` group whose text starts after its `{`: each item's path (`self` left out),
+/// up to the group's `}`; None when it does not close.
+fn group_items(text: &str) -> Option<Vec<Vec<String>>> {
+    let (mut depth, mut end) = (0usize, None);
+    for (k, c) in text.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                end = Some(k);
+                break;
+            }
+            '}' => depth -= 1,
+            _ => {}
+        }
     }
+    let inside = &text[..end?];
+    Some(
+        inside
+            .split(',')
+            .map(|item| {
+                let head: String = item
+                    .trim()
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == ':')
+                    .collect();
+                head.split("::")
+                    .filter(|s| !s.is_empty() && *s != "self")
+                    .map(String::from)
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
+/// The circles among modules (module path -> the modules it names): each a list of modules, found by
+/// following names between modules of which neither is inside the other.
+fn circles(edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<String>> {
+    let related = |a: &[String], b: &[String]| a.starts_with(b) || b.starts_with(a);
     // a module is on a circle when it reaches itself; each circle reported once, by its members
     let mut found: BTreeSet<Vec<String>> = BTreeSet::new();
     for start in edges.keys() {
         let mut seen = BTreeSet::new();
         let mut stack = vec![(start.clone(), vec![start.join("::")])];
         while let Some((m, path)) = stack.pop() {
-            for t in edges.get(&m).into_iter().flatten() {
+            for t in edges.get(&m).into_iter().flatten().filter(|t| !related(&m, t)) {
                 if t == start {
                     let mut members = path.clone();
                     members.sort();
@@ -217,14 +242,119 @@ fn circles(files: &BTreeMap<Vec<String>, Vec<Vec<String>>>) -> Vec<Vec<String>> 
     found.into_iter().collect()
 }
 
-/// The module graph of a set of sources (path under `src/`, text).
-fn graph(sources: &[(PathBuf, String)]) -> BTreeMap<Vec<String>, Vec<Vec<String>>> {
+/// Whether a source defines an item `name` (a struct, enum, function, constant, type, trait or module).
+fn defines(text: &str, name: &str) -> bool {
+    [
+        "struct ", "enum ", "fn ", "const ", "static ", "type ", "trait ", "mod ", "union ",
+    ]
+    .iter()
+    .any(|kind| {
+        let pat = format!("{kind}{name}");
+        text.match_indices(&pat).any(|(k, _)| {
+            let before = text[..k].chars().next_back();
+            let after = text[k + pat.len()..].chars().next();
+            before.is_none_or(|c| !(c.is_alphanumeric() || c == '_'))
+                && after.is_none_or(|c| !(c.is_alphanumeric() || c == '_'))
+        })
+    })
+}
+
+/// The sources by module path (comments left out), and the module each named path leads to, through
+/// the `pub use` re-exports on the way to the file that defines the item.
+struct Modules(BTreeMap<Vec<String>, String>);
+
+impl Modules {
+    /// The longest prefix of `path` that is a module.
+    fn module_of(&self, path: &[String]) -> Option<Vec<String>> {
+        (0..=path.len())
+            .rev()
+            .map(|k| path[..k].to_vec())
+            .find(|p| self.0.contains_key(p))
+    }
+
+    /// The module a `pub use` path written in module `m` starts from, joined with the rest of it.
+    fn absolute(m: &[String], segs: &[String]) -> Vec<String> {
+        match segs.first().map(String::as_str) {
+            Some("crate") => segs[1..].to_vec(),
+            Some("self") => m.iter().chain(&segs[1..]).cloned().collect(),
+            Some("super") => {
+                let mut base = m.to_vec();
+                let mut rest = segs;
+                while rest.first().is_some_and(|s| s == "super") {
+                    base.pop();
+                    rest = &rest[1..];
+                }
+                base.into_iter().chain(rest.iter().cloned()).collect()
+            }
+            _ => m.iter().chain(segs).cloned().collect(),
+        }
+    }
+
+    /// The module that defines `name` as module `m` exports it.
+    fn follow(&self, m: Vec<String>, name: &str, depth: usize) -> Vec<String> {
+        let text = &self.0[&m];
+        if depth > 8 || defines(text, name) {
+            return m;
+        }
+        for stmt in text.split("pub use ").skip(1).filter_map(|s| s.split(';').next()) {
+            let stmt: String = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
+            let (path, items) = match stmt.split_once("::{") {
+                Some((p, list)) => (p.to_string(), list.trim_end_matches('}').to_string()),
+                None => match stmt.rsplit_once("::") {
+                    Some((p, item)) => (p.to_string(), item.to_string()),
+                    None => continue,
+                },
+            };
+            let segs: Vec<String> = path.split("::").map(String::from).collect();
+            let Some(from) = self.module_of(&Self::absolute(&m, &segs)) else {
+                continue;
+            };
+            let names: Vec<&str> = items
+                .split(',')
+                .map(|i| i.split(" as ").next().unwrap_or("").trim())
+                .collect();
+            let exported = names.contains(&name) || (names.contains(&"*") && defines(&self.0[&from], name));
+            if exported && from != m {
+                return self.follow(from, name, depth + 1);
+            }
+        }
+        m
+    }
+
+    /// The module a named path (from the crate's root) leads to.
+    fn resolve(&self, path: &[String]) -> Option<Vec<String>> {
+        let m = self.module_of(path)?;
+        match path.get(m.len()) {
+            Some(name) => Some(self.follow(m, name, 0)),
+            None => Some(m),
+        }
+    }
+}
+
+/// The module graph of a set of sources (path under `src/`, text): the modules each names.
+fn graph(sources: &[(PathBuf, String)]) -> BTreeMap<Vec<String>, BTreeSet<Vec<String>>> {
+    let strip = |text: &str| -> String {
+        text.lines()
+            .map(|l| l.split("//").next().unwrap_or(""))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let modules = Modules(
+        sources
+            .iter()
+            .map(|(rel, text)| (module_path(rel), strip(text)))
+            .collect(),
+    );
     sources
         .iter()
-        .map(|(rel, text)| {
+        .map(|(rel, _)| {
             let m = module_path(rel);
             let is_bin = rel.starts_with("cli") || rel == Path::new("main.rs");
-            let named = named_modules(text, &m, is_bin);
+            let named = named_modules(&modules.0[&m], &m, is_bin)
+                .iter()
+                .filter_map(|p| modules.resolve(p))
+                .filter(|t| !t.is_empty() && *t != m)
+                .collect();
             (m, named)
         })
         .collect()
@@ -245,6 +375,16 @@ fn the_circle_check_finds_two_files_that_name_each_other() {
     assert_eq!(
         circles(&graph(&two)),
         vec![vec!["a::x".to_string(), "a::y".to_string()]]
+    );
+    // through a parent's re-export: a names b's item by its folder, b names a
+    let through = [
+        src("a.rs", "use crate::b::Z;"),
+        src("b/mod.rs", "mod z;\npub use z::*;"),
+        src("b/z.rs", "pub struct Z;\nfn f() { crate::a::g(); }"),
+    ];
+    assert_eq!(
+        circles(&graph(&through)),
+        vec![vec!["a".to_string(), "b::z".to_string()]]
     );
     // a parent and its children name each other freely; a one-way name is no circle
     let none = [
