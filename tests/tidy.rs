@@ -173,7 +173,7 @@ fn named_modules(text: &str, module: &[String], is_bin: bool) -> Vec<Vec<String>
             let path: Vec<String> = base.into_iter().chain(segs).collect();
             // a group (`crate::band::{ResponseTable, spread}`) names each of its items
             let after = &code[start + rest.len()..];
-            match after.strip_prefix('{').and_then(|g| group_items(g)) {
+            match after.strip_prefix('{').and_then(group_items) {
                 Some(items) => out.extend(items.into_iter().map(|i| path.iter().cloned().chain(i).collect())),
                 None => out.push(path),
             }
