@@ -365,11 +365,13 @@ fn faults_are_counted_flagged_and_survived() {
     let names = Names { prefix: prefix.clone() };
     let _daemon = daemon(&cfg);
     let sub = ForecastSubscriber::new(&names).unwrap();
+    // a field of one component at its own time: its phase moves on between fields (the same values
+    // stamped later would be a frozen processor's, refused)
     let field = |t: f64| WaveField {
         components: vec![FieldComponent {
             omega_rad_s: 0.6,
             direction_rad: std::f64::consts::PI,
-            amplitude_m: num_complex::Complex64::new(1.0, 0.0),
+            amplitude_m: num_complex::Complex64::from_polar(1.0, (0.6 * t).rem_euclid(std::f64::consts::TAU)),
         }],
         reference_m: [0.0, 0.0],
         time_s: t,

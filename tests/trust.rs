@@ -457,7 +457,7 @@ fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_truste
             // a component above the database's 1.6 rad/s holding as much variance as all the others
             let var: f64 = w.components.iter().map(|c| 0.5 * (c[2] * c[2] + c[3] * c[3])).sum();
             let a = (2.0 * var).sqrt();
-            w.components.push([3.0, 0.0, a, 0.0]);
+            w.components.push([2.0, 0.0, a, 0.0]);
         }
     }
     let run = drive(&records);
@@ -472,6 +472,107 @@ fn wave_variance_outside_the_database_is_flagged_and_beyond_the_share_not_truste
     let share = run.statuses.last().unwrap().dropped_wave_share;
     assert!((share - HALF_THE_SEA).abs() < SHARE_TOL, "{share}");
 }
+
+/// A wave processor that froze: from the fault on, every field repeats the first one after it, value
+/// for value, stamped later. The repeats are refused and flagged (`waves_frozen`), and the forecasts
+/// take the last field that differed, at its own age, until it is too old to forecast from. Fails
+/// before the flag: every repeat was taken as a new field (`wave_time_s` advancing), never flagged,
+/// and its forecasts trusted.
+#[test]
+fn a_frozen_wave_processor_is_flagged_and_its_repeats_refused() {
+    let mut records = log().records.clone();
+    let t0 = start(&records);
+    let frozen_at = records
+        .iter()
+        .position(|(t, r)| matches!(r, Record::Waves(_)) && t - t0 > FAULT_AT_S)
+        .expect("a wave field after the fault time");
+    let Record::Waves(frozen) = records[frozen_at].1.clone() else {
+        unreachable!()
+    };
+    for (_, r) in records[frozen_at + 1..].iter_mut() {
+        if let Record::Waves(w) = r {
+            *w = shipcast::shell::record::WavesRecord {
+                time_s: w.time_s,
+                ..frozen.clone()
+            };
+        }
+    }
+    let run = drive(&records);
+    invariants(&run);
+    // the refused repeats: every forecast after the freeze takes the frozen field at its own time
+    let late: Vec<&ForecastHeader> = after(&run, t0, records[frozen_at].0 - t0 + FROZEN_NOTICED_S);
+    assert!(!late.is_empty(), "forecasts after the freeze");
+    for h in &late {
+        assert!(h.flags & flags::WAVES_FROZEN != 0, "{:?}", flags::names(h.flags));
+        assert_eq!(h.wave_time_s, frozen.time_s, "a repeat taken as a new field");
+    }
+    assert!(
+        run.statuses.iter().any(|s| s.flags & flags::WAVES_FROZEN != 0),
+        "the status says so"
+    );
+    // the field grows old: stale, then no forecast at all
+    let last = run.statuses.last().unwrap();
+    assert!(last.flags & flags::STALE_WAVES != 0, "{:?}", flags::names(last.flags));
+}
+
+/// A wave field with one component no sea has (1,000 m, 10 m: more than the highest seas; 5 m in a
+/// sea of 2.5 m: a jump over the last fields no sea makes) is refused and flagged
+/// (`waves_implausible`): no forecast takes it, they go on from the last field taken, and none moves
+/// the hull more than the sea does. Fails before the check: the field was taken, and its forecasts
+/// trusted with a heave of tens of metres.
+#[test]
+fn a_wave_field_that_is_not_a_sea_is_refused_and_flagged() {
+    let base_heave = max_heave(baseline(), start(&log().records));
+    for amplitude_m in [1000.0, 10.0, 5.0] {
+        let mut records = log().records.clone();
+        let t0 = start(&records);
+        let at = records
+            .iter()
+            .position(|(t, r)| matches!(r, Record::Waves(_)) && t - t0 > FAULT_AT_S)
+            .expect("a wave field after the fault time");
+        let Record::Waves(w) = &mut records[at].1 else {
+            unreachable!()
+        };
+        w.components.push([0.6, 0.0, amplitude_m, 0.0]);
+        let bad_time_s = w.time_s;
+        let run = drive(&records);
+        invariants(&run);
+        forecasts_go_on(&records, &run, "a field that is not a sea");
+        assert!(
+            run.statuses.iter().any(|s| s.flags & flags::WAVES_IMPLAUSIBLE != 0),
+            "{amplitude_m} m: not flagged"
+        );
+        assert!(
+            run.forecasts.iter().all(|(h, _)| h.wave_time_s != bad_time_s),
+            "{amplitude_m} m: a forecast took the field"
+        );
+        let heave = max_heave(&run, t0);
+        assert!(
+            heave <= HEAVE_GROWTH * base_heave,
+            "{amplitude_m} m: heave {heave} m against {base_heave} m"
+        );
+    }
+}
+
+/// The largest heave any forecast issued after the fault time carries, m (vessel 0).
+fn max_heave(run: &Run, t0: f64) -> f64 {
+    run.forecasts
+        .iter()
+        .filter(|(h, _)| h.issue_time_s - t0 > FAULT_AT_S)
+        .flat_map(|(h, v)| {
+            let per = h.steps as usize + 1;
+            v[2 * per..3 * per].iter().map(|x| x.abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How far past the clean run's largest forecast heave a run's may go, as a factor: forecasts from
+/// other fields of the same sea differ, but not by a sea's worth.
+const HEAVE_GROWTH: f64 = 1.5;
+
+/// The freeze is seen at the first repeat, one radar period after the frozen field, s (a margin of a
+/// second for the tick).
+const FROZEN_NOTICED_S: f64 = 6.0;
 
 /// A fault put into one record of the log.
 #[derive(Debug, Clone, Copy)]

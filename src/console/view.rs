@@ -289,6 +289,11 @@ fn flag_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
         ("no_wave_components", "Radar: an empty field: not trusted"),
         ("waves_dropped", "Part of the sea is outside the vessel database"),
         (
+            "waves_frozen",
+            "Radar: the wave processor repeats itself (frozen): its last field ages",
+        ),
+        ("waves_implausible", "Radar: a field that is not a sea was refused"),
+        (
             "model_error_unchecked",
             "Learning the model's error: no lead trusted until forecasts are checked",
         ),

@@ -130,6 +130,18 @@ impl Engine {
             self.state_flags |= flags::CLOCK_STEP;
             self.scans.clear();
         }
+        let repeat = self.scans.back().is_some_and(|last| {
+            last.frame == scan.frame
+                && last.grid.x_m == scan.grid.x_m
+                && last.grid.y_m == scan.grid.y_m
+                && last.grid.values.len() == scan.grid.values.len()
+                // bit for bit: a scan's invalid cells are NaN
+                && last.grid.values.iter().zip(&scan.grid.values).all(|(a, b)| a.to_bits() == b.to_bits())
+                && last.grid.time_s < scan.grid.time_s
+        });
+        if !stepped && self.refuse_frozen(repeat, "radar scan") {
+            return;
+        }
         // a sequence shares one grid at increasing times: another grid starts it again
         if self.scans.back().is_some_and(|last| {
             last.frame != scan.frame
@@ -140,6 +152,7 @@ impl Engine {
             self.scans.clear();
         }
         self.scans.push_back(scan);
+        self.waves_frozen = false;
         while self.scans.len() > self.cfg.radar_snapshots as usize {
             self.scans.pop_front();
         }
@@ -157,14 +170,17 @@ impl Engine {
             });
         match crate::waves::observe::from_scans(&grids, frame, &self.radar_options) {
             Ok(f) => {
+                if !stepped && self.refuse_implausible(&f, "radar scans' field") {
+                    return;
+                }
                 let f = f.pruned(self.cfg.wave_variance_kept);
                 if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
-                    self.field = Some(f);
+                    self.take_field(f);
                 }
             }
             Err(e) => {
-                c.rejected += 1;
-                log_count(c.rejected, &format!("radar scans not inverted: {e}"));
+                self.counters.rejected += 1;
+                log_count(self.counters.rejected, &format!("radar scans not inverted: {e}"));
             }
         }
     }
@@ -185,10 +201,62 @@ impl Engine {
         if stepped {
             self.state_flags |= flags::CLOCK_STEP;
         }
-        let f = f.pruned(self.cfg.wave_variance_kept);
-        if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
-            self.field = Some(f);
+        if !stepped && self.refuse_implausible(&f, "wave field") {
+            return;
         }
+        let f = f.pruned(self.cfg.wave_variance_kept);
+        let repeat = self
+            .field
+            .as_ref()
+            .is_some_and(|old| f.time_s > old.time_s && !f.components.is_empty() && f.components == old.components);
+        if !stepped && self.refuse_frozen(repeat, "wave field") {
+            return;
+        }
+        if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
+            self.take_field(f);
+        }
+    }
+
+    /// The newest field, taken: its variance joins the recent ones the next is judged against.
+    fn take_field(&mut self, f: WaveField) {
+        self.recent_variance_m2.push_back(f.variance_m2());
+        while self.recent_variance_m2.len() > RECENT_FIELDS {
+            self.recent_variance_m2.pop_front();
+        }
+        self.field = Some(f);
+        self.waves_frozen = false;
+    }
+
+    /// A field that is not a sea ([`implausible`]: more than the highest seas, a component steeper
+    /// than a wave can be, a jump the sea does not make between fields seconds apart) is refused
+    /// (counted, logged) and `waves_implausible` raised until the next status; the forecasts keep the
+    /// last field taken. True when refused.
+    fn refuse_implausible(&mut self, f: &WaveField, what: &str) -> bool {
+        let Some(why) = implausible(f, &self.recent_variance_m2) else {
+            return false;
+        };
+        self.state_flags |= flags::WAVES_IMPLAUSIBLE;
+        let c = &mut self.counters;
+        c.rejected += 1;
+        log_count(c.rejected, &format!("{what} refused as not a sea: {why}"));
+        true
+    }
+
+    /// A wave field (not an empty one) or radar scan that repeats the one before it, value for value,
+    /// at a later stamp (`repeat`) is a processor that froze: the sea it describes would have moved on. It is refused
+    /// (counted, logged) and `waves_frozen` raised, so that the field the forecasts take ages as it
+    /// should; the next one that differs clears it. True when refused.
+    fn refuse_frozen(&mut self, repeat: bool, what: &str) -> bool {
+        if repeat {
+            self.waves_frozen = true;
+            let c = &mut self.counters;
+            c.rejected += 1;
+            log_count(
+                c.rejected,
+                &format!("{what} refused: the same values as the one before, stamped later (a frozen processor)"),
+            );
+        }
+        repeat
     }
 
     /// The ship-to-ship link's health.
@@ -204,6 +272,55 @@ impl Engine {
             );
         }
     }
+}
+
+/// The largest significant wave height a field may claim, m: above the highest seas measured (about
+/// 20 m), so a field that claims more is its processor's error.
+pub const MAX_FIELD_HS_M: f64 = 25.0;
+/// The steepest a component may be, k |a|: Stokes' limiting wave (H / L = 1/7, k a = pi / 7).
+pub const MAX_STEEPNESS: f64 = std::f64::consts::PI / 7.0;
+/// A field's variance may be at most this many times the median of the last [`RECENT_FIELDS`] taken
+/// (its significant wave height four times theirs: no sea builds so fast between fields seconds
+/// apart) ...
+pub const MAX_VARIANCE_JUMP: f64 = 16.0;
+/// ... once that many have been taken ...
+pub const RECENT_FIELDS: usize = 8;
+/// ... where it claims a significant wave height above this, m (a sea building from calm is no jump).
+pub const JUMP_FLOOR_HS_M: f64 = 1.0;
+
+/// Why a field is not a sea, judged against the variances of the last fields taken (m^2); None when
+/// it may be one.
+pub fn implausible(f: &WaveField, recent_variance_m2: &std::collections::VecDeque<f64>) -> Option<String> {
+    let var = f.variance_m2();
+    let hs = 4.0 * var.sqrt();
+    if hs.is_nan() || hs > MAX_FIELD_HS_M {
+        return Some(format!(
+            "it claims a significant wave height of {hs:.1} m (at most {MAX_FIELD_HS_M} m)"
+        ));
+    }
+    if let Some(c) = f
+        .components
+        .iter()
+        .find(|c| f.wave_number(c.omega_rad_s) * c.amplitude_m.norm() > MAX_STEEPNESS)
+    {
+        return Some(format!(
+            "a component of {:.2} m at {:.3} rad/s is steeper than a wave can be",
+            c.amplitude_m.norm(),
+            c.omega_rad_s
+        ));
+    }
+    if recent_variance_m2.len() >= RECENT_FIELDS && hs > JUMP_FLOOR_HS_M {
+        let mut v: Vec<f64> = recent_variance_m2.iter().copied().collect();
+        v.sort_by(f64::total_cmp);
+        let median = v[v.len() / 2];
+        if var > MAX_VARIANCE_JUMP * median {
+            return Some(format!(
+                "its variance, {var:.3} m^2, is {:.0} times the last fields' ({median:.3} m^2)",
+                var / median
+            ));
+        }
+    }
+    None
 }
 
 /// A stamp judged by its source's clock, counted and logged: None if refused, else whether the source's

@@ -83,6 +83,14 @@ pub mod flags {
     /// first minute or so of a run): the model error is the configured prior's, and no lead is
     /// trusted (horizon 0) until it has been checked.
     pub const MODEL_ERROR_UNCHECKED: u32 = 65536;
+    /// The wave processor repeats its last field (or the radar its last scan) at later stamps: a frozen
+    /// processor. The repeats are refused; the forecasts take the last field that differed, at its own
+    /// age (stale, then suppressed, as it grows old).
+    pub const WAVES_FROZEN: u32 = 131_072;
+    /// A wave field was refused as not a sea since the last status (status only): more than the
+    /// highest seas, a component steeper than a wave can be, or a jump over the last fields no sea
+    /// makes. The forecasts keep the last field taken.
+    pub const WAVES_IMPLAUSIBLE: u32 = 262_144;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -104,6 +112,8 @@ pub mod flags {
             (NAVIGATION_FALLBACK, "navigation_fallback"),
             (QUASI_STATIC_WAVES, "quasi_static_waves"),
             (MODEL_ERROR_UNCHECKED, "model_error_unchecked"),
+            (WAVES_FROZEN, "waves_frozen"),
+            (WAVES_IMPLAUSIBLE, "waves_implausible"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)

@@ -102,7 +102,11 @@ fn power_of_ten(mut n: u64) -> bool {
 }
 
 /// Flags of events, kept in the state until the next status reports them.
-const ONE_SHOT_FLAGS: u32 = flags::NUMERICAL | flags::CLOCK_STEP | flags::MOTION_IMPLAUSIBLE | flags::MOTION_RESTARTED;
+const ONE_SHOT_FLAGS: u32 = flags::NUMERICAL
+    | flags::CLOCK_STEP
+    | flags::MOTION_IMPLAUSIBLE
+    | flags::MOTION_RESTARTED
+    | flags::WAVES_IMPLAUSIBLE;
 
 /// The daemon's state and decisions, driven by a clock the caller supplies (seconds: monotonic wall
 /// time live, the log's time in replay): the same code for both.
@@ -147,6 +151,11 @@ pub struct Engine {
     last_forecast_time: f64,
     last_compute_ms: f64,
     last_horizon: [f64; MAX_VESSELS],
+    /// The newest wave field or radar scan repeated the one before at a later stamp (refused: a frozen
+    /// processor).
+    waves_frozen: bool,
+    /// The variances of the last fields taken, m^2 (what the next is judged against).
+    recent_variance_m2: std::collections::VecDeque<f64>,
     /// The ship-to-ship link's newest health, and the engine clock it arrived at.
     link: Option<(message::LinkStatus, f64)>,
     state_flags: u32,
@@ -230,6 +239,8 @@ impl Engine {
             last_compute_ms: 0.0,
             last_horizon: [0.0; MAX_VESSELS],
             link: None,
+            waves_frozen: false,
+            recent_variance_m2: std::collections::VecDeque::new(),
             state_flags: 0,
             model_error_logged: 0,
             model_mean: vec![Default::default(); n_bodies],

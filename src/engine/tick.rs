@@ -128,6 +128,9 @@ impl Engine {
         if disagree {
             fl |= flags::CLOCKS_DISAGREE;
         }
+        if self.waves_frozen {
+            fl |= flags::WAVES_FROZEN;
+        }
         // ages are never negative: a field stamped a little after the newest motion (within the
         // clocks' skew) is taken as current
         match self.field.as_ref().map(|f| (t0 - f.time_s).max(0.0)) {

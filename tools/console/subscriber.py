@@ -46,6 +46,8 @@ FLAGS = [
     "navigation_fallback",
     "quasi_static_waves",
     "model_error_unchecked",
+    "waves_frozen",
+    "waves_implausible",
 ]
 
 
