@@ -30,10 +30,10 @@ pub struct ShipcastConfig {
     pub console: ConsoleConfig,
     #[serde(default)]
     pub link: LinkConfig,
-    /// Directory of the config file (relative paths are resolved against it); set by [`load`].
+    /// Directory of the config file (relative paths are resolved against it); set by [`crate::shell::config::load`].
     #[serde(skip)]
     pub dir: PathBuf,
-    /// The config file itself, as given; set by [`load`] (for messages that name it).
+    /// The config file itself, as given; set by [`crate::shell::config::load`] (for messages that name it).
     #[serde(skip)]
     pub path: PathBuf,
 }

@@ -1,8 +1,8 @@
 //! The forecast's band and trusted span (pure): how wide a forecast's band is and over which leads
 //! it is trusted, the model error learnt from past forecasts, the start's error (the sensor's bias
-//! or a heel), and the normal distribution's tails. Files: [`response`] (the model's response table),
-//! [`span`] (the band and the span of one forecast), [`model_error`] (learning from checks),
-//! [`start`] (the start's error and heel), [`normal`].
+//! or a heel), and the normal distribution's tails. Files: `response` (the model's response table),
+//! `span` (the band and the span of one forecast), `model_error` (learning from checks),
+//! `start` (the start's error and heel), `normal`.
 //!
 //! A forecast knows a wave component only over the leads at which the water that brings it to the
 //! vessel had been observed (`waves::horizon::known_leads`: for a radar, while that water was inside

@@ -132,7 +132,7 @@ impl ModelErrorCurve {
     }
 
     /// Series i's model error variance at `lead_s` (the band at lead 0 is the start's,
-    /// [`start_sigma`]), its model's motion variance being
+    /// [`crate::band::start_sigma`]), its model's motion variance being
     /// `model_motion_var`: linear between the check leads, constant beyond them; never below the
     /// sensor's noise.
     pub fn at(&self, i: usize, lead_s: f64, model_motion_var: f64) -> f64 {
@@ -318,7 +318,7 @@ impl ModelError {
     /// A forecast issued at `issue_s` (values and standard deviations series-major, `steps + 1` each,
     /// step `dt_s`), each series' motion standard deviation by the model, the model error it was
     /// made with, and `errors`: each series' start error variance (the band's floor: as
-    /// [`SpreadOptions::start_var`]) and estimate error variance (what a check against a later
+    /// [`crate::band::SpreadOptions::start_var`]) and estimate error variance (what a check against a later
     /// estimate differs by beside the motion); missing, the sensor's noise.
     pub fn record(
         &mut self,

@@ -165,16 +165,18 @@ impl Computer {
                         values.extend_from_slice(&s.sigma);
                         for b in 0..n_bodies.min(MAX_VESSELS) {
                             let ok = job.trustworthy && s.to_s[b] > 0.0;
-                            header.horizon_s[b] = if ok { s.to_s[b] } else { 0.0 };
-                            header.trusted_from_s[b] = if ok { s.from_s[b] } else { 0.0 };
+                            if ok {
+                                header.set_span(b, s.from_s[b], s.to_s[b]);
+                            } else {
+                                header.set_span(b, 0.0, 0.0);
+                            }
                         }
                         motion_sigma = s.motion_sigma;
                     }
                     None => {
                         // no band known: not a band of zero
                         values.extend(std::iter::repeat_n(f64::NAN, 6 * n_bodies * (steps + 1)));
-                        header.horizon_s = [0.0; MAX_VESSELS];
-                        header.trusted_from_s = [0.0; MAX_VESSELS];
+                        header.untrust_all();
                     }
                 }
                 if quasi_static > 0 {

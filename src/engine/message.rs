@@ -326,6 +326,24 @@ impl LinkStatus {
     pub const TYPE_NAME: &'static str = "shipcast_LinkStatus_v1";
 }
 
+impl ForecastHeader {
+    /// Vessel `b`'s trusted span, from `from_s` to `to_s` of lead (both 0: not trusted at all); a
+    /// vessel beyond the payload's [`MAX_VESSELS`] has none.
+    pub fn set_span(&mut self, b: usize, from_s: f64, to_s: f64) {
+        if b < MAX_VESSELS {
+            self.trusted_from_s[b] = from_s;
+            self.horizon_s[b] = to_s;
+        }
+    }
+
+    /// No vessel trusted at any lead.
+    pub fn untrust_all(&mut self) {
+        for b in 0..MAX_VESSELS {
+            self.set_span(b, 0.0, 0.0);
+        }
+    }
+}
+
 /// Checks a received forecast against its own header, as every consumer must before indexing it
 /// (`ForecastSubscriber` does, for `watch`, `demo` and the console): the schema, the vessel count, the
 /// series count and the payload's length (displacements and standard deviations), a positive step,

@@ -16,8 +16,7 @@ impl Engine {
                     header.flags |= flags::WAVES_DROPPED;
                 }
                 if d.dropped_wave_share > self.cfg.max_dropped_wave_share {
-                    header.horizon_s = [0.0; MAX_VESSELS];
-                    header.trusted_from_s = [0.0; MAX_VESSELS];
+                    header.untrust_all();
                 }
                 self.counters.forecasts += 1;
                 self.last_forecast_time = header.issue_time_s;
@@ -89,10 +88,7 @@ impl Engine {
         let per = header.steps as usize + 1;
         let n = per * header.n_series as usize;
         for (b, _) in self.job_unknown.iter().enumerate().filter(|(_, u)| **u) {
-            if b < MAX_VESSELS {
-                header.horizon_s[b] = 0.0;
-                header.trusted_from_s[b] = 0.0;
-            }
+            header.set_span(b, 0.0, 0.0);
             if values.len() != 2 * n {
                 continue;
             }

@@ -1,7 +1,7 @@
 //! Uniformly partitioned convolution of the radiation kernel with the velocities of a run (pure).
 //!
 //! At every step k the stepper needs P_k = sum_{m >= 1} K~_m s_{k-m}, with K~_m the weighted kernel taps
-//! of [`super::model::Kernel::Convolution`] (n x n, m = 0..taps-1) and s_j the velocities of the run
+//! of [`crate::rom::model::Kernel::Convolution`] (n x n, m = 0..taps-1) and s_j the velocities of the run
 //! (s_0 = 0: the start's own velocity and the history before it are the caller's `known` part). Summed
 //! directly that is n^2 (taps - 1) multiply-adds per step: 3.5 million for the two-ship pair at
 //! dt = 0.025 s (24 001 taps), and the step streams the whole kernel (27.6 MB) from memory.

@@ -21,10 +21,10 @@
 //! and damping are in C and B_lin; each anti-roll tank adds a state after the active body DOFs;
 //! lines and fenders are nonlinear forces relative to their equilibrium value.
 //!
-//! Radiation memory two ways ([`memory`]): direct convolution (trapezoid rule on K sampled at dt, the
+//! Radiation memory two ways ([`crate::radiation::memory`]): direct convolution (trapezoid rule on K sampled at dt, the
 //! reference; a run's own velocities meet the taps beyond one block by partitioned FFTs,
-//! [`partitioned`]) or the modal state-space model ([`crate::radiation::statespace`]: vector fit, balanced
-//! truncation, passivity enforced) with its exact discrete update ([`modal`]). The wave force, a sum of sinusoids
+//! [`crate::radiation::partitioned`]) or the modal state-space model ([`crate::radiation::statespace`]: vector fit, balanced
+//! truncation, passivity enforced) with its exact discrete update ([`crate::radiation::modal`]). The wave force, a sum of sinusoids
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
 

@@ -122,45 +122,20 @@ impl WaveHeader {
     }
 }
 
-// SAFETY: `MotionSample` is `#[repr(C)]` of plain numbers and arrays of them, with no pointers or
-// references; its layout is the one `layouts_are_what_the_docs_say` checks.
-unsafe impl ZeroCopySend for MotionSample {
-    unsafe fn type_name() -> &'static str {
-        MotionSample::TYPE_NAME
-    }
+/// Marks the engine's messages for iceoryx2, with their stable type names.
+macro_rules! zero_copy_send {
+    ($($t:ident),*) => {$(
+        // SAFETY: the message is `#[repr(C)]` of plain numbers and arrays of them, with no pointers
+        // or references; its layout is the one `layouts_are_what_the_docs_say` checks.
+        unsafe impl ZeroCopySend for $t {
+            unsafe fn type_name() -> &'static str {
+                $t::TYPE_NAME
+            }
+        }
+    )*};
 }
 
-// SAFETY: `NavigationSample` is `#[repr(C)]` of plain numbers and arrays of them, with no pointers or
-// references; its layout is the one `layouts_are_what_the_docs_say` checks.
-unsafe impl ZeroCopySend for NavigationSample {
-    unsafe fn type_name() -> &'static str {
-        NavigationSample::TYPE_NAME
-    }
-}
-
-// SAFETY: `ForecastHeader` is `#[repr(C)]` of plain numbers and arrays of them, with no pointers or
-// references; its layout is the one `layouts_are_what_the_docs_say` checks.
-unsafe impl ZeroCopySend for ForecastHeader {
-    unsafe fn type_name() -> &'static str {
-        ForecastHeader::TYPE_NAME
-    }
-}
-
-// SAFETY: `Status` is `#[repr(C)]` of plain numbers and arrays of them, with no pointers or
-// references; its layout is the one `layouts_are_what_the_docs_say` checks.
-unsafe impl ZeroCopySend for Status {
-    unsafe fn type_name() -> &'static str {
-        Status::TYPE_NAME
-    }
-}
-
-// SAFETY: `LinkStatus` is `#[repr(C)]` of plain numbers and arrays of them, with no pointers or
-// references; its layout is the one `layouts_are_what_the_docs_say` checks.
-unsafe impl ZeroCopySend for LinkStatus {
-    unsafe fn type_name() -> &'static str {
-        LinkStatus::TYPE_NAME
-    }
-}
+zero_copy_send!(MotionSample, NavigationSample, ForecastHeader, Status, LinkStatus);
 
 #[cfg(test)]
 mod tests {
