@@ -4,7 +4,9 @@ use super::HEALTH_PERIOD_S;
 use super::health::Health;
 use crate::shell::config::ShipcastConfig;
 use crate::shell::daemon::wall_s;
-use crate::shell::ipc::wire::{ForecastHeader, MotionSample, NavigationSample, Status};
+use crate::shell::ipc::wire::{
+    ForecastHeader, LinkStatus, MotionSample, NavigationSample, Status, check_forecast, check_status,
+};
 use crate::shell::ipc::{LinkPublisher, Local, LocalSubscriber, Names, Output, OutputPublisher, SensorPublisher};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -179,6 +181,36 @@ fn send_loop(
     Ok(())
 }
 
+/// The link's health, published on this ship's services; the link's coming up or going down logged.
+fn tell_health(s: &LinkStatus, health_out: &LinkPublisher, was_up: &mut Option<bool>, stale_s: f64) {
+    if let Err(e) = health_out.publish(s) {
+        tracing::warn!("publishing the link's health: {e}");
+    }
+    let up = s.up == 1;
+    if *was_up != Some(up) {
+        if up {
+            tracing::info!(latency_ms = s.latency_ms, "the other ship is heard");
+        } else if was_up.is_some() {
+            tracing::warn!(
+                last_message_age_s = s.last_message_age_s,
+                "nothing from the other ship for {stale_s} s: link down"
+            );
+        }
+        *was_up = Some(up);
+    }
+}
+
+/// The other ship's forecast or status, checked as every consumer here checks them
+/// ([`check_forecast`], [`check_status`]: the header against the payload, the schema) before it is
+/// republished on this ship's services; Err: why it is dropped.
+fn peer_output(message: Message) -> Result<Output, String> {
+    match message {
+        Message::Forecast(h, v) => check_forecast(&h, v.len()).map(|()| Output::Forecast(h, v)),
+        Message::Status(s) => check_status(&s).map(|()| Output::Status(s)),
+        other => Err(format!("{} is not an output", other.kind())),
+    }
+}
+
 /// Zenoh to local services, and the link's health.
 fn receive_loop(
     cfg: &ShipcastConfig,
@@ -201,28 +233,13 @@ fn receive_loop(
     let mut health = Health::new(cfg.link.window_s, cfg.link.stale_s);
     let mut next_health = wall_s();
     let mut was_up: Option<bool> = None;
-    let (mut refused, mut foreign) = (0u64, 0u64);
+    let (mut refused, mut foreign, mut dropped) = (0u64, 0u64, 0u64);
     let mut same_name_said = false;
     while !stop.load(Ordering::Relaxed) {
         let now = wall_s();
         if now >= next_health {
             let s = health.status(now, sent.load(Ordering::Relaxed));
-            if let Err(e) = health_out.publish(&s) {
-                tracing::warn!("publishing the link's health: {e}");
-            }
-            let up = s.up == 1;
-            if was_up != Some(up) {
-                if up {
-                    tracing::info!(latency_ms = s.latency_ms, "the other ship is heard");
-                } else if was_up.is_some() {
-                    tracing::warn!(
-                        last_message_age_s = s.last_message_age_s,
-                        "nothing from the other ship for {} s: link down",
-                        cfg.link.stale_s
-                    );
-                }
-                was_up = Some(up);
-            }
+            tell_health(&s, &health_out, &mut was_up, cfg.link.stale_s);
             next_health = now + HEALTH_PERIOD_S;
         }
         let wait = Duration::from_secs_f64((next_health - wall_s()).clamp(0.001, HEALTH_PERIOD_S));
@@ -253,8 +270,16 @@ fn receive_loop(
         let r = match env.message {
             Message::Motion(m) if !cfg.link.own_vessels.contains(&m.vessel) => sensors.motion(&m),
             Message::Navigation(n) if !cfg.link.own_vessels.contains(&n.vessel) => sensors.navigation(&n),
-            Message::Forecast(h, v) => outputs.publish(&Output::Forecast(h, v)),
-            Message::Status(s) => outputs.publish(&Output::Status(s)),
+            m @ (Message::Forecast(..) | Message::Status(..)) => match peer_output(m) {
+                Ok(out) => outputs.publish(&out),
+                Err(why) => {
+                    dropped += 1;
+                    if dropped.is_power_of_two() {
+                        tracing::warn!(dropped, "{from}'s {why}: dropped");
+                    }
+                    Ok(())
+                }
+            },
             // the other ship says it measures a vessel this one measures: not taken
             _ => {
                 foreign += 1;
@@ -273,4 +298,41 @@ fn receive_loop(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::message::{FORECAST_SCHEMA_VERSION, STATUS_SCHEMA_VERSION};
+
+    /// Was: the other ship's forecasts were republished here unchecked (a header that does not fit
+    /// its payload reached every consumer of this ship's services).
+    #[test]
+    fn a_peer_forecast_or_status_that_does_not_fit_its_header_is_dropped() {
+        let h = ForecastHeader {
+            schema_version: FORECAST_SCHEMA_VERSION,
+            n_vessels: 1,
+            n_series: 6,
+            steps: 10,
+            dt_s: 0.1,
+            ..ForecastHeader::default()
+        };
+        assert!(peer_output(Message::Forecast(h, vec![0.0; 2 * 11 * 6])).is_ok());
+        // the standard deviations missing, a vessel count beyond the payload's, another schema
+        assert!(peer_output(Message::Forecast(h, vec![0.0; 11 * 6])).is_err());
+        let many = ForecastHeader {
+            n_vessels: 9,
+            n_series: 54,
+            ..h
+        };
+        assert!(peer_output(Message::Forecast(many, vec![0.0; 2 * 11 * 54])).is_err());
+        let old = ForecastHeader { schema_version: 1, ..h };
+        assert!(peer_output(Message::Forecast(old, vec![0.0; 2 * 11 * 6])).is_err());
+        let s = Status {
+            schema_version: STATUS_SCHEMA_VERSION,
+            ..Status::default()
+        };
+        assert!(peer_output(Message::Status(s)).is_ok());
+        assert!(peer_output(Message::Status(Status::default())).is_err());
+    }
 }
