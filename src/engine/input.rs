@@ -130,25 +130,28 @@ impl Engine {
             self.state_flags |= flags::CLOCK_STEP;
             self.scans.clear();
         }
-        let repeat = self.scans.back().is_some_and(|last| {
+        // a sequence shares one grid at increasing times: another grid starts it again
+        let continues = self.scans.back().map(|last| {
             last.frame == scan.frame
                 && last.grid.x_m == scan.grid.x_m
                 && last.grid.y_m == scan.grid.y_m
-                && last.grid.values.len() == scan.grid.values.len()
-                // bit for bit: a scan's invalid cells are NaN
-                && last.grid.values.iter().zip(&scan.grid.values).all(|(a, b)| a.to_bits() == b.to_bits())
                 && last.grid.time_s < scan.grid.time_s
         });
+        // the same values bit for bit (a scan's invalid cells are NaN)
+        let repeat = continues == Some(true)
+            && self.scans.back().is_some_and(|last| {
+                last.grid.values.len() == scan.grid.values.len()
+                    && last
+                        .grid
+                        .values
+                        .iter()
+                        .zip(&scan.grid.values)
+                        .all(|(a, b)| a.to_bits() == b.to_bits())
+            });
         if !stepped && self.refuse_frozen(repeat, "radar scan") {
             return;
         }
-        // a sequence shares one grid at increasing times: another grid starts it again
-        if self.scans.back().is_some_and(|last| {
-            last.frame != scan.frame
-                || last.grid.x_m != scan.grid.x_m
-                || last.grid.y_m != scan.grid.y_m
-                || last.grid.time_s >= scan.grid.time_s
-        }) {
+        if continues == Some(false) {
             self.scans.clear();
         }
         self.scans.push_back(scan);
