@@ -95,29 +95,33 @@ impl Channel {
             .collect()
     }
 
-    /// The trusted horizon of this channel from the vessels' horizons (a relative motion: the shorter
-    /// of its two vessels'), s.
-    pub fn horizon_s(&self, ext: &External, horizon_s: &[f64]) -> f64 {
-        self.of_vessels(ext, horizon_s, f64::min)
+    /// The series (6 per vessel, of `n_series`) the channel's value changes with.
+    pub fn series(&self, ext: &External, n_series: usize) -> Vec<usize> {
+        let zero = vec![0.0; n_series];
+        let base = self.value(ext, &zero);
+        (0..n_series)
+            .filter(|&i| {
+                let mut x = zero.clone();
+                x[i] = 1.0;
+                let d = self.value(ext, &x) - base;
+                d.is_finite() && d != 0.0
+            })
+            .collect()
     }
 
-    /// The start of this channel's trusted span from the vessels' starts (a relative motion: the
-    /// later of its two vessels'), s.
-    pub fn trusted_from_s(&self, ext: &External, from_s: &[f64]) -> f64 {
-        self.of_vessels(ext, from_s, f64::max)
-    }
-
-    /// A per-vessel number of the channel's vessel, or of its two vessels joined by `join`.
-    fn of_vessels(&self, ext: &External, per_vessel: &[f64], join: fn(f64, f64) -> f64) -> f64 {
-        let h = |b: usize| per_vessel.get(b).copied().unwrap_or(0.0);
-        match self.source {
-            Source::Dof { vessel, .. } => h(vessel),
-            Source::Point { point, .. } => ext.points.get(point).map_or(0.0, |p| h(p.body)),
-            Source::Relative { relative, .. } => ext
-                .relative_motions
-                .get(relative)
-                .map_or(0.0, |r| join(h(ext.points[r.a].body), h(ext.points[r.b].body))),
+    /// The channel's trusted span (from, to), s of lead, from each series' (`span(i)`, as the
+    /// forecast sends them): where every series it reads is trusted (a relative motion: both
+    /// vessels'). (0, 0): not trusted, or it reads no series.
+    pub fn span_s(&self, ext: &External, n_series: usize, span: impl Fn(usize) -> (f64, f64)) -> (f64, f64) {
+        let read = self.series(ext, n_series);
+        if read.is_empty() {
+            return (0.0, 0.0);
         }
+        let (from, to) = read.iter().fold((0.0f64, f64::INFINITY), |(f, t), &i| {
+            let (a, b) = span(i);
+            (f.max(a), t.min(b))
+        });
+        if to > 0.0 && to >= from { (from, to) } else { (0.0, 0.0) }
     }
 }
 
@@ -138,12 +142,19 @@ impl Channel {
     }
 }
 
-/// The span a set of channels is trusted over: the shortest of their horizons (infinite for none).
-pub fn trusted_horizon_s(channels: &[Channel], ext: &External, horizon_s: &[f64]) -> f64 {
-    channels
+/// The span a set of channels is trusted over (from, to), s of lead: where each of them is
+/// ([`Channel::span_s`]); (0, infinity) for none.
+pub fn trusted_span_s(
+    channels: &[Channel],
+    ext: &External,
+    n_series: usize,
+    span: impl Fn(usize) -> (f64, f64),
+) -> (f64, f64) {
+    let (from, to) = channels
         .iter()
-        .map(|c| c.horizon_s(ext, horizon_s))
-        .fold(f64::INFINITY, f64::min)
+        .map(|c| c.span_s(ext, n_series, &span))
+        .fold((0.0f64, f64::INFINITY), |(f, t), (a, b)| (f.max(a), t.min(b)));
+    if to > 0.0 && to >= from { (from, to) } else { (0.0, 0.0) }
 }
 
 /// Resolves a channel name against the vessels' names and the system's points and relative motions.

@@ -130,7 +130,8 @@ pub struct ForecastConfig {
     pub max_navigation_age_s: f64,
     /// The pose at a forecast's start is a straight line through this much of the newest fixes, s.
     pub navigation_window_s: f64,
-    /// Radar scans (`<prefix>/elevation`) of one grid inverted together into a field.
+    /// The most radar scans (`<prefix>/elevation`) of one grid inverted together into a field: the
+    /// window takes as many of the newest as the blind zone needs (`waves::window::window_scans`).
     pub radar_snapshots: u32,
     /// The model's error, as a fraction of each motion's standard deviation, until the daemon has
     /// learnt it from its own forecasts (`band::ModelError`): the floor of the forecast's band,
@@ -163,7 +164,7 @@ impl Default for ForecastConfig {
             max_dropped_wave_share: 0.1,
             max_navigation_age_s: 5.0,
             navigation_window_s: 30.0,
-            radar_snapshots: 3,
+            radar_snapshots: 48,
             model_error: 0.15,
             trusted_nrmse: 0.6,
         }
@@ -413,7 +414,7 @@ impl Default for RadarConfig {
             cells: 128,
             period_s: 2.0,
             noise_m: 0.05,
-            snapshots: 3,
+            snapshots: 48,
             record_grid_every: 15,
             output: "components".into(),
             blind_radius_m: 200.0,

@@ -14,8 +14,9 @@
 use crate::hydro::VesselSystem;
 use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel, Track};
 use crate::waves::field::{Region, WaveField};
-use crate::waves::observe::{Grid, GridFrame, GridOptions, from_grids};
+use crate::waves::observe::{Grid, GridFrame, GridOptions, from_scans};
 use crate::waves::sea::{SeaState, realize_all};
+use crate::waves::window::{MIN_WINDOW_SCANS, window_scans};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -34,7 +35,8 @@ pub struct RadarSpec {
     pub period_s: f64,
     /// Elevation noise (standard deviation), m.
     pub noise_m: f64,
-    /// Snapshots per inversion (>= 2 tells opposite directions apart).
+    /// The most snapshots the processor's window holds (>= 2 tells opposite directions apart): it takes
+    /// as many as its blind zone needs (`waves::window::window_scans`).
     pub snapshots: usize,
     /// Frequency band the processor keeps, rad/s.
     pub omega_min_rad_s: f64,
@@ -145,7 +147,10 @@ pub struct Simulation {
     pub truth: Forecast,
     pub n_bodies: usize,
     rng: ChaCha8Rng,
+    /// The radar's newest snapshots of one map (at most `radar.snapshots`), and how many of the newest
+    /// the processor's next inversion takes (`waves::window::window_scans` of its last field).
     grids: Vec<Grid>,
+    window: usize,
     /// Reference points of the bodies in the system frame, m.
     body_xy_m: Vec<[f64; 2]>,
     /// The radar map's centre, earth frame, m.
@@ -202,6 +207,7 @@ impl Simulation {
             .map(|c| c.amplitude_m.norm_sqr() * c.omega_rad_s)
             .sum::<f64>()
             / energy.max(f64::MIN_POSITIVE);
+        let window = spec.radar.snapshots.max(2);
         Ok(Simulation {
             mean_wavenumber_rad_m: if energy > 0.0 { sea.wave_number(mean_omega) } else { 0.0 },
             drift: vec![[0.0; 6]; sys.spec.bodies.len()],
@@ -214,6 +220,7 @@ impl Simulation {
             truth,
             spec,
             grids: vec![],
+            window,
         })
     }
 
@@ -400,10 +407,11 @@ impl Simulation {
             time_s: t_s,
             values,
         });
-        if self.grids.len() > r.snapshots.max(2) {
+        let most = r.snapshots.max(2);
+        if self.grids.len() > most {
             self.grids.remove(0);
         }
-        if self.grids.len() < r.snapshots.max(2) {
+        if self.grids.len() < MIN_WINDOW_SCANS.min(most) {
             return None;
         }
         let opts = GridOptions {
@@ -412,16 +420,20 @@ impl Simulation {
             omega_min_rad_s: r.omega_min_rad_s,
             omega_max_rad_s: r.omega_max_rad_s,
             mean_direction_rad: None,
-            region: Some(Region::Disc {
-                centre_m: o,
-                radius_m: r.radius_m,
-            }),
+            region: None,
         };
-        // the processor's own inversion: the cells it does not see taken as zero
-        let zeroed: Vec<Grid> = self.grids.iter().map(zero_invalid).collect();
-        from_grids(&zeroed, &opts)
-            .ok()
-            .map(|f| f.pruned(PROCESSOR_VARIANCE_KEPT))
+        // the processor's own inversion of its window's newest scans, the cells it does not see taken
+        // as zero; its region what they saw (the blind zone, a masked sector, the window's length)
+        let used = self.window.clamp(1, most).min(self.grids.len());
+        let frame = GridFrame {
+            origin_m: [0.0, 0.0],
+            orientation_rad: 0.0,
+        };
+        let f = from_scans(&self.grids[self.grids.len() - used..], frame, &opts)
+            .ok()?
+            .pruned(PROCESSOR_VARIANCE_KEPT);
+        self.window = window_scans(&f, r.period_s, most);
+        Some(f)
     }
 
     /// The newest radar scan as a processor that publishes maps sends it: the grid along its axes from
@@ -495,14 +507,6 @@ pub fn shadow(xs: &[f64], ys: &[f64], values: &[f64], antenna_m: [f64; 2], heigh
         }
     }
     out
-}
-
-/// A grid with its NaN cells (not seen) set to zero.
-pub fn zero_invalid(g: &Grid) -> Grid {
-    Grid {
-        values: g.values.iter().map(|v| if v.is_finite() { *v } else { 0.0 }).collect(),
-        ..g.clone()
-    }
 }
 
 fn interp(f: &Forecast, series: &[f64], t_s: f64, i: usize) -> f64 {

@@ -20,6 +20,7 @@ mod indep_barge_probe;
 mod kramers_kronig;
 #[cfg(feature = "link")]
 mod link;
+mod reach;
 mod replay;
 mod rom;
 mod sim_truth;

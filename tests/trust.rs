@@ -82,6 +82,17 @@ fn invariants(run: &Run) {
                 "horizon {hz} s beyond the forecast's {len} s"
             );
         }
+        for i in 0..h.n_series as usize {
+            let (from, to) = h.series_span(i);
+            assert!(
+                from.is_finite() && to.is_finite() && from >= 0.0 && (to == 0.0 || from <= to),
+                "series {i}'s span {from} to {to} s"
+            );
+            assert!(
+                to <= len + HORIZON_ROUNDING_S,
+                "series {i}'s span ends at {to} s, beyond the forecast's {len} s"
+            );
+        }
     }
     for s in &run.statuses {
         assert!(
@@ -91,6 +102,23 @@ fn invariants(run: &Run) {
         );
         assert!(s.horizon_s.iter().all(|h| h.is_finite()), "{:?}", s.horizon_s);
     }
+}
+
+#[test]
+#[should_panic(expected = "series 2's span ends at 10.5 s")]
+fn the_invariants_fail_on_a_series_span_longer_than_the_forecast() {
+    let mut h = ForecastHeader {
+        n_vessels: 1,
+        n_series: 6,
+        steps: 100,
+        dt_s: 0.1,
+        ..ForecastHeader::default()
+    };
+    h.set_series_span(2, 0.0, 10.5);
+    invariants(&Run {
+        forecasts: vec![(h, vec![0.0; 12])],
+        statuses: vec![],
+    });
 }
 
 #[test]

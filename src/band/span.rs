@@ -24,6 +24,11 @@ pub const MAX_GROUP_DELAY_S: f64 = 60.0;
 /// trusted span: 1 cm, 0.1 deg (below what a motion sensor tells apart from its noise).
 pub const SIGNIFICANT: [f64; 3] = [0.01, 0.001_745, 0.001_745];
 
+/// The same per DOF (surge, sway, heave, roll, pitch, yaw), for each series' own span: an expected
+/// error within `forecast.trusted_nrmse` of this is trusted however little the series moves (pitch in
+/// beam seas is known to be nearly still).
+pub const SIGNIFICANT_DOF: [f64; 6] = [0.01, 0.01, 0.01, 0.001_745, 0.001_745, 0.001_745];
+
 /// What decides a band's width and the trusted span.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpreadOptions {
@@ -47,9 +52,15 @@ pub struct SpreadOptions {
 pub struct Spread {
     /// Standard deviation of every series at every step, series-major (6 per vessel, m or rad).
     pub sigma: Vec<f64>,
-    /// Per vessel, the first and the last lead of the trusted span, s (both 0: not trusted at all).
+    /// Per vessel, the first and the last lead of the trusted span, s (both 0: not trusted at all):
+    /// where every DOF that moves enough to matter is trusted.
     pub from_s: Vec<f64>,
     pub to_s: Vec<f64>,
+    /// Per series (6 per vessel), the first and the last lead of its own trusted span, s (both 0: not
+    /// trusted at all): its expected error within `trusted_nrmse` of its motion, or of
+    /// [`SIGNIFICANT_DOF`] when it moves less.
+    pub series_from_s: Vec<f64>,
+    pub series_to_s: Vec<f64>,
     /// Per series, the response's own standard deviation, m or rad.
     pub motion_sigma: Vec<f64>,
 }
@@ -103,10 +114,19 @@ pub fn spread(
             to_s[b] = last as f64 * dt_s;
         }
     }
+    let (series_from_s, series_to_s) = (0..n_series)
+        .map(|i| {
+            let allowed = opts.trusted_nrmse * judged[i].max(SIGNIFICANT_DOF[i % 6]);
+            longest_run((0..n).map(|k| span_sigma[i * n + k] <= allowed))
+                .map_or((0.0, 0.0), |(first, last)| (first as f64 * dt_s, last as f64 * dt_s))
+        })
+        .unzip();
     Spread {
         sigma,
         from_s,
         to_s,
+        series_from_s,
+        series_to_s,
         motion_sigma,
     }
 }

@@ -559,3 +559,43 @@ fn a_calm_vessel_is_trusted_throughout_and_garbage_amplitudes_are_left_out() {
     assert!(s.sigma.iter().all(|x| *x == 0.0));
     assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 10.0));
 }
+
+#[test]
+fn each_series_has_its_own_span_and_one_that_errs_does_not_shorten_the_others() {
+    // heave (1 m) forecast within 0.1 m, pitch (1 rad) off by 0.9 rad from 0.5 s on, sway still:
+    // the vessel is trusted only as far as pitch allows, heave and sway throughout (fails before:
+    // one span per vessel)
+    let mut m = ModelError::new(0.15, vec![0.0; 6]);
+    let prior = ModelErrorCurve::prior(0.15, 6);
+    let (dt, n) = (0.5, 21);
+    let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
+    for c in 0..200 {
+        let t0 = c as f64;
+        let mut values = vec![0.0; 6 * n];
+        for k in 0..n {
+            let err = if k > 0 { 1.0 } else { 0.0 };
+            values[2 * n + k] = motion(t0 + k as f64 * dt) - 0.1 * err;
+            values[4 * n + k] = motion(t0 + k as f64 * dt) - 0.9 * err;
+        }
+        m.record(t0, dt, (&values, &vec![0.0; 6 * n]), &[1.0; 6], &prior, (&[], &[]));
+        m.observe(t0, |at| {
+            Some(
+                (0..6)
+                    .map(|i| if i == 2 || i == 4 { motion(at) } else { 0.0 })
+                    .collect(),
+            )
+        });
+    }
+    let opts = SpreadOptions {
+        model_error: m.curve(),
+        trusted_nrmse: 0.6,
+        start_var: vec![],
+        start_offset: vec![],
+    };
+    let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, 40, 0.5, &opts);
+    assert!(s.to_s[0] < 10.0, "{:?}", s.to_s);
+    assert_eq!((s.series_from_s[2], s.series_to_s[2]), (0.0, 10.0));
+    assert_eq!((s.series_from_s[1], s.series_to_s[1]), (0.0, 10.0));
+    assert!(s.series_to_s[4] < 10.0, "{:?}", s.series_to_s);
+    assert_eq!(s.series_from_s.len(), 6);
+}

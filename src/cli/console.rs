@@ -82,6 +82,7 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                             dt_s: h.dt_s,
                             horizon_s: h.horizon_s[..nv].to_vec(),
                             trusted_from_s: h.trusted_from_s[..nv].to_vec(),
+                            series_span_s: (0..6 * nv).map(|i| [h.series_span(i).0, h.series_span(i).1]).collect(),
                             flags: flags::names(h.flags),
                             compute_ms: h.compute_ms,
                             x: v.chunks_exact(n).take(6 * nv).map(|s| s.to_vec()).collect(),

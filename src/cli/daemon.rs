@@ -481,6 +481,20 @@ fn finite(v: f64) -> serde_json::Value {
     }
 }
 
+/// A trusted span (from, to) as `[from, to]`.
+fn span_json(span: &(f64, f64)) -> serde_json::Value {
+    serde_json::json!([finite(span.0), finite(span.1)])
+}
+
+/// The operator channel of point `point`'s `axis` (0 x, 1 y, 2 z), for its trusted span.
+fn point_channel(point: usize, axis: usize) -> shipcast::operation::Channel {
+    shipcast::operation::Channel {
+        name: String::new(),
+        source: shipcast::operation::Source::Point { point, axis },
+        limit: f64::INFINITY,
+    }
+}
+
 /// A forecast as one JSON line (the format `watch --json` documents): per vessel its DOFs in output
 /// units (`heave_m`, `roll_deg`, ...) and the displacement of its points of interest (`x_m`, `y_m`,
 /// `z_m`, global axes); non-finite numbers as null.
@@ -510,8 +524,9 @@ pub fn forecast_json(
             let points: Map<String, Value> = ext
                 .points
                 .iter()
-                .filter(|p| p.body == b)
-                .map(|p| {
+                .enumerate()
+                .filter(|(_, p)| p.body == b)
+                .map(|(idx, p)| {
                     let mut comps = [vec![], vec![], vec![]];
                     let mut x = vec![0.0; 6 * n_vessels];
                     for k in 0..n {
@@ -524,7 +539,25 @@ pub fn forecast_json(
                         }
                     }
                     let [x_m, y_m, z_m] = comps;
-                    (p.name.clone(), json!({"x_m": x_m, "y_m": y_m, "z_m": z_m}))
+                    let spans: Vec<Value> = (0..3)
+                        .map(|axis| {
+                            span_json(&point_channel(idx, axis).span_s(ext, 6 * n_vessels, |i| h.series_span(i)))
+                        })
+                        .collect();
+                    (
+                        p.name.clone(),
+                        json!({"x_m": x_m, "y_m": y_m, "z_m": z_m, "spans_s": spans}),
+                    )
+                })
+                .collect();
+            // each DOF's own trusted span [from, to], s of lead
+            let spans: Map<String, Value> = Dof::ALL
+                .iter()
+                .map(|d| {
+                    (
+                        d.output_name().to_string(),
+                        span_json(&h.series_span(6 * b + d.index())),
+                    )
                 })
                 .collect();
             // the band: each DOF's standard deviation, after the displacements on the wire
@@ -546,6 +579,7 @@ pub fn forecast_json(
                 "name": name,
                 "trusted_from_s": finite(h.trusted_from_s[b]),
                 "horizon_s": finite(h.horizon_s[b]),
+                "spans_s": spans,
                 "dofs": dofs,
                 "sigma": sigma,
                 "points": points

@@ -368,16 +368,15 @@ fn windows_report(
         let n = f.steps as usize + 1;
         let series: Vec<&[f64]> = f.values.chunks_exact(n).collect();
         let sigma: Vec<&[f64]> = f.sigma.chunks_exact(n).collect();
+        let (trusted_from_s, trusted_s) =
+            shipcast::operation::trusted_span_s(channels, ext, series.len(), |i| f.series_span(i));
         let span = SpanForecast {
             t0_s: f.issue_time_s,
             dt_s: f.dt_s,
             values: &series,
             sigma: &sigma,
-            trusted_from_s: channels
-                .iter()
-                .map(|c| c.trusted_from_s(ext, &f.trusted_from_s))
-                .fold(0.0, f64::max),
-            trusted_s: shipcast::operation::trusted_horizon_s(channels, ext, &f.horizon_s),
+            trusted_from_s,
+            trusted_s,
         };
         let s = score_forecast_windows(channels, ext, &span, measured, duration_s, confidence);
         if let Some(s) = s {
@@ -466,12 +465,13 @@ fn forecast_plot(
                 .enumerate()
                 .map(|(k, v)| (k as f64 * f.dt_s, v))
                 .collect();
+            let (trusted_from_s, trusted_s) = ch.span_s(ext, series.len(), |i| f.series_span(i));
             plot::ForecastPanel {
                 name: ch.name.clone(),
                 unit: ch.unit().into(),
                 limit: ch.limit,
-                trusted_s: ch.horizon_s(ext, &f.horizon_s).min(span),
-                trusted_from_s: ch.trusted_from_s(ext, &f.trusted_from_s),
+                trusted_s: trusted_s.min(span),
+                trusted_from_s,
                 band,
                 forecast,
                 actual,
@@ -495,7 +495,9 @@ fn report(
     let nb = sys.spec.bodies.len();
     let step = 5.0;
     let mut json_vessels = vec![];
-    let mut csv = String::from("vessel,dof,lead_s,correlation,nrmse,ssp,bias,coverage_90,spread_skill,count\n");
+    let mut csv = String::from(
+        "vessel,dof,lead_s,correlation,nrmse,ssp,bias,coverage_90,spread_skill,count,correlation_trusted,coverage_90_trusted,count_trusted\n",
+    );
     let mut curves: Vec<plot::SkillCurve> = vec![];
     let mut lead = vec![];
     for b in 0..nb {
@@ -505,9 +507,17 @@ fn report(
             let measured = &measured_all[6 * b + d];
             let fs = series_forecasts(forecasts, 6 * b + d);
             let sk = skill::score(&fs, measured, step, length_s);
+            // the same, scored only inside each forecast's trusted span of this DOF
+            let inside = trusted_values(forecasts, 6 * b + d);
+            let fs_trusted: Vec<SeriesForecast> = fs
+                .iter()
+                .zip(&inside)
+                .map(|(f, v)| SeriesForecast { values: v, ..*f })
+                .collect();
+            let trusted = skill::score(&fs_trusted, measured, step, length_s);
             lead = sk.lead_s.clone();
-            dofs.push(dof_skill_json(dof, &sk));
-            push_skill_csv(&mut csv, name, dof, &sk);
+            dofs.push(dof_skill_json(dof, &sk, &trusted));
+            push_skill_csv(&mut csv, name, dof, &sk, &trusted);
             if ["heave", "roll", "pitch"].contains(dof) {
                 curves.push(plot::SkillCurve {
                     label: format!("{name} {dof}"),
@@ -546,6 +556,30 @@ fn series_forecasts(forecasts: &[ForecastRecord], s: usize) -> Vec<SeriesForecas
         .collect()
 }
 
+/// Series `s` of every forecast, NaN outside its own trusted span (nothing where it has none).
+fn trusted_values(forecasts: &[ForecastRecord], s: usize) -> Vec<Vec<f64>> {
+    forecasts
+        .iter()
+        .map(|f| {
+            let n = f.steps as usize + 1;
+            let (from, to) = f.series_span(s);
+            let values = f.values.get(s * n..(s + 1) * n).unwrap_or(&[]);
+            values
+                .iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    let lead = k as f64 * f.dt_s;
+                    if to > 0.0 && lead >= from - 1e-9 && lead <= to + 1e-9 {
+                        *v
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Numbers as the inside of a JSON array, 5 decimals, null where not finite.
 fn json_numbers(v: &[f64]) -> String {
     v.iter()
@@ -560,25 +594,34 @@ fn json_numbers(v: &[f64]) -> String {
         .join(",")
 }
 
-/// One DOF's skill as a JSON member, `"dof":{...}`: a value per lead of every score.
-fn dof_skill_json(dof: &str, sk: &skill::Skill) -> String {
+/// One DOF's skill as a JSON member, `"dof":{...}`: a value per lead of every score, and `trusted`:
+/// correlation, coverage and count inside each forecast's trusted span of the DOF.
+fn dof_skill_json(dof: &str, sk: &skill::Skill, trusted: &skill::Skill) -> String {
     format!(
-        "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"spread_skill\":[{}],\"count\":[{}]}}",
+        "\"{dof}\":{{\"correlation\":[{}],\"nrmse\":[{}],\"ssp\":[{}],\"bias\":[{}],\"coverage_90\":[{}],\"spread_skill\":[{}],\"count\":[{}],\"trusted\":{{\"correlation\":[{}],\"coverage_90\":[{}],\"count\":[{}]}}}}",
         json_numbers(&sk.correlation),
         json_numbers(&sk.nrmse),
         json_numbers(&sk.ssp),
         json_numbers(&sk.bias),
         json_numbers(&sk.coverage_90),
         json_numbers(&sk.spread_skill),
-        sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")
+        sk.count.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","),
+        json_numbers(&trusted.correlation),
+        json_numbers(&trusted.coverage_90),
+        trusted
+            .count
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
     )
 }
 
 /// Appends a CSV row per lead of one DOF's skill to `csv`.
-fn push_skill_csv(csv: &mut String, name: &str, dof: &str, sk: &skill::Skill) {
+fn push_skill_csv(csv: &mut String, name: &str, dof: &str, sk: &skill::Skill, trusted: &skill::Skill) {
     for l in 0..sk.lead_s.len() {
         csv.push_str(&format!(
-            "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{}\n",
+            "{name},{dof},{},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{:.5},{:.5},{}\n",
             sk.lead_s[l],
             sk.correlation[l],
             sk.nrmse[l],
@@ -586,9 +629,38 @@ fn push_skill_csv(csv: &mut String, name: &str, dof: &str, sk: &skill::Skill) {
             sk.bias[l],
             sk.coverage_90[l],
             sk.spread_skill[l],
-            sk.count[l]
+            sk.count[l],
+            trusted.correlation[l],
+            trusted.coverage_90[l],
+            trusted.count[l]
         ));
     }
+}
+
+/// The median over the log of each DOF's own trusted span, as JSON members
+/// `"vessel":{"heave":[from, to],..}` (null when no forecast has it).
+fn dof_span_medians(sys: &shipcast::hydro::VesselSystem, forecasts: &[ForecastRecord]) -> String {
+    let median = |mut v: Vec<f64>| -> String {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).map_or("null".to_string(), |x| format!("{x:.3}"))
+    };
+    (0..sys.spec.bodies.len())
+        .map(|b| {
+            let dofs = shipcast::hydro::Dof::NAMES
+                .iter()
+                .enumerate()
+                .map(|(d, dof)| {
+                    let spans: Vec<(f64, f64)> = forecasts.iter().map(|f| f.series_span(6 * b + d)).collect();
+                    let from = median(spans.iter().map(|s| s.0).collect());
+                    let to = median(spans.iter().map(|s| s.1).collect());
+                    format!("\"{dof}\":[{from},{to}]")
+                })
+                .collect::<Vec<_>>()
+                .join(",");
+            format!("\"{}\":{{{dofs}}}", sys.spec.bodies[b].name)
+        })
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// The median over the log of a per-vessel value of the forecasts (`get`), as JSON members
@@ -623,10 +695,11 @@ fn write_skill_json(
     // the median published trusted span of each vessel over the log
     let horizons = vessel_medians(sys, forecasts, |f| &f.horizon_s);
     let froms = vessel_medians(sys, forecasts, |f| &f.trusted_from_s);
+    let spans = dof_span_medians(sys, forecasts);
     std::fs::write(
         dir.join("skill.json"),
         format!(
-            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"trusted_horizon_s\":{{{horizons}}},\"trusted_from_s\":{{{froms}}},\"vessels\":{{{}}}}}\n",
+            "{{\"reference\":\"{reference}\",\"lead_s\":[{lead_json}],\"forecasts\":{},\"trusted_horizon_s\":{{{horizons}}},\"trusted_from_s\":{{{froms}}},\"spans_s\":{{{spans}}},\"vessels\":{{{}}}}}\n",
             forecasts.len(),
             json_vessels.join(",")
         ),

@@ -83,6 +83,8 @@ pub struct Forecast {
     pub horizon_s: Vec<f64>,
     /// Start of each vessel's trusted span, s of lead.
     pub trusted_from_s: Vec<f64>,
+    /// Each series' own trusted span [from, to], s of lead (6 per vessel; empty: the vessel's).
+    pub series_span_s: Vec<[f64; 2]>,
     pub flags: Vec<&'static str>,
     pub compute_ms: f64,
     pub x: Vec<Vec<f64>>,
@@ -90,6 +92,19 @@ pub struct Forecast {
     pub sigma: Vec<Vec<f64>>,
     /// When it arrived (wall clock).
     pub received_wall_s: f64,
+}
+
+impl Forecast {
+    /// Series `i`'s trusted span (from, to), s of lead: its own, or its vessel's when none was sent.
+    pub fn series_span(&self, i: usize) -> (f64, f64) {
+        match self.series_span_s.get(i) {
+            Some([f, t]) => (*f, *t),
+            None => (
+                self.trusted_from_s.get(i / 6).copied().unwrap_or(0.0),
+                self.horizon_s.get(i / 6).copied().unwrap_or(0.0),
+            ),
+        }
+    }
 }
 
 /// The daemon's health as its status service reports it.
@@ -314,16 +329,20 @@ impl Console {
 
     /// Trusted horizon of channel `c` for the current forecast, s.
     pub fn horizon_of(&self, c: &Channel) -> f64 {
-        self.forecast
-            .as_ref()
-            .map_or(0.0, |f| c.horizon_s(&self.external, &f.horizon_s))
+        self.span_of(c).1
     }
 
-    /// Start of channel `c`'s trusted span for the current forecast, s (the later of its vessels').
+    /// Start of channel `c`'s trusted span for the current forecast, s.
     pub fn trusted_from_of(&self, c: &Channel) -> f64 {
-        self.forecast
-            .as_ref()
-            .map_or(0.0, |f| c.trusted_from_s(&self.external, &f.trusted_from_s))
+        self.span_of(c).0
+    }
+
+    /// Channel `c`'s trusted span (from, to) for the current forecast, s: where every series it reads
+    /// is trusted ([`Channel::span_s`]; (0, 0) without a forecast).
+    pub fn span_of(&self, c: &Channel) -> (f64, f64) {
+        self.forecast.as_ref().map_or((0.0, 0.0), |f| {
+            c.span_s(&self.external, f.x.len(), |i| f.series_span(i))
+        })
     }
 
     /// Channel `c`'s band along the current forecast: its standard deviation at each step (empty
@@ -344,8 +363,8 @@ impl Console {
         }
         let series: Vec<Vec<f64>> = chans.iter().map(|c| self.forecast_channel(c)).collect();
         let sigmas: Vec<Vec<f64>> = chans.iter().map(|c| self.forecast_sigma(c)).collect();
-        let trusted_s = operation::trusted_horizon_s(chans, &self.external, &f.horizon_s);
-        let trusted_from_s = chans.iter().map(|c| self.trusted_from_of(c)).fold(0.0, f64::max);
+        let (trusted_from_s, trusted_s) =
+            operation::trusted_span_s(chans, &self.external, f.x.len(), |i| f.series_span(i));
         let n = series.iter().map(|s| s.len()).min().unwrap_or(0);
         let m = operation::trusted_samples(n, f.dt_s, trusted_s);
         // the trusted span's samples: from its start (a whole step) to its end
@@ -512,6 +531,7 @@ mod tests {
             dt_s: 1.0,
             horizon_s: vec![horizon_s, horizon_s],
             trusted_from_s: vec![0.0, 0.0],
+            series_span_s: vec![],
             flags: vec![],
             compute_ms: 12.0,
             x,

@@ -211,9 +211,22 @@ fn forecast_lines(c: &Console, f: &Forecast, now_wall_s: f64, out: &mut Vec<(Sev
         format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
     ));
     for (b, (n, h)) in c.vessels.iter().zip(&f.horizon_s).enumerate() {
+        // each of heave, roll and pitch's own span, when the daemon sent them
+        let dofs: String = if f.series_span_s.len() >= 6 * (b + 1) {
+            let span = |d: usize, name: &str| {
+                let [from, to] = f.series_span_s[6 * b + d];
+                format!("{name} {from:.0}-{to:.0}")
+            };
+            format!(" ({}, {}, {} s)", span(2, "heave"), span(3, "roll"), span(4, "pitch"))
+        } else {
+            String::new()
+        };
         match f.trusted_from_s.get(b).copied().filter(|x| *x > 0.0) {
-            Some(from) => out.push((Severity::Caution, format!("Trusted ahead: {n} {from:.0}-{h:.0} s"))),
-            None => out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s"))),
+            Some(from) => out.push((
+                Severity::Caution,
+                format!("Trusted ahead: {n} {from:.0}-{h:.0} s{dofs}"),
+            )),
+            None => out.push((Severity::Ok, format!("Trusted ahead: {n} {h:.0} s{dofs}"))),
         }
     }
 }

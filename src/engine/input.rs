@@ -4,6 +4,7 @@
 use super::estimator::{Refusal, Taken};
 use super::message::{Input, LinkStatus, MotionSample, NavigationSample, SCHEMA_VERSION, Scan, flags};
 use super::*;
+use crate::waves::window::{MIN_WINDOW_SCANS, window_scans};
 
 impl Engine {
     /// One input that arrived at `clock_s` (engine clock). Every stamp is judged against its source's
@@ -156,13 +157,21 @@ impl Engine {
         }
         self.scans.push_back(scan);
         self.waves_frozen = false;
-        while self.scans.len() > self.cfg.radar_snapshots as usize {
+        let most = self.cfg.radar_snapshots as usize;
+        while self.scans.len() > most {
             self.scans.pop_front();
         }
-        if self.scans.len() < self.cfg.radar_snapshots as usize {
+        if self.scans.len() < MIN_WINDOW_SCANS.min(most) {
             return;
         }
-        let grids: Vec<crate::waves::observe::Grid> = self.scans.iter().map(|s| s.grid.clone()).collect();
+        // the newest scans of the window the last field asked for (all there are while it fills)
+        let used = self.radar_window.clamp(1, most).min(self.scans.len());
+        let grids: Vec<crate::waves::observe::Grid> = self
+            .scans
+            .iter()
+            .skip(self.scans.len() - used)
+            .map(|s| s.grid.clone())
+            .collect();
         let frame = self
             .scans
             .back()
@@ -177,6 +186,8 @@ impl Engine {
                     return;
                 }
                 let f = f.pruned(self.cfg.wave_variance_kept);
+                let period_s = (f.time_s - grids[0].time_s) / (used - 1).max(1) as f64;
+                self.radar_window = window_scans(&f, period_s, most);
                 if stepped || self.field.as_ref().is_none_or(|old| f.time_s > old.time_s) {
                     self.take_field(f);
                 }

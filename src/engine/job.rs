@@ -164,11 +164,15 @@ impl Computer {
                     Some(s) => {
                         values.extend_from_slice(&s.sigma);
                         for b in 0..n_bodies.min(MAX_VESSELS) {
-                            let ok = job.trustworthy && s.to_s[b] > 0.0;
-                            if ok {
-                                header.set_span(b, s.from_s[b], s.to_s[b]);
-                            } else {
+                            if !job.trustworthy {
                                 header.set_span(b, 0.0, 0.0);
+                                continue;
+                            }
+                            // the vessel's span, then each series' own (a vessel whose pitch errs
+                            // everywhere may still have its heave trusted)
+                            header.set_span(b, s.from_s[b], s.to_s[b]);
+                            for i in 6 * b..6 * b + 6 {
+                                header.set_series_span(i, s.series_from_s[i], s.series_to_s[i]);
                             }
                         }
                         motion_sigma = s.motion_sigma;

@@ -14,8 +14,8 @@ pub const SCHEMA_VERSION: u32 = 1;
 /// Schema version of the waves payload (2: the radar's blind zone and coverage).
 pub const WAVES_SCHEMA_VERSION: u32 = 2;
 /// Schema version of the forecast payload (2: the standard deviations after the displacements, the
-/// start of each vessel's trusted span).
-pub const FORECAST_SCHEMA_VERSION: u32 = 2;
+/// start of each vessel's trusted span; 3: each series' own trusted span).
+pub const FORECAST_SCHEMA_VERSION: u32 = 3;
 /// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
 /// estimator's refusals, restarts and bias).
 pub const STATUS_SCHEMA_VERSION: u32 = 4;
@@ -177,7 +177,7 @@ pub mod nav_valid {
     pub const ROT: u32 = 2;
 }
 
-/// Header of a forecast sample. 128 bytes; `schema_version` = [`FORECAST_SCHEMA_VERSION`].
+/// Header of a forecast sample. 512 bytes; `schema_version` = [`FORECAST_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 pub struct ForecastHeader {
@@ -205,6 +205,12 @@ pub struct ForecastHeader {
     /// Start of each vessel's trusted span, s of lead (before it the waves that move the vessel have
     /// not been observed yet: a probe far up-wave).
     pub trusted_from_s: [f64; MAX_VESSELS],
+    /// Each series' own trusted span (6 per vessel in DOF order, the first `n_series`), s of lead:
+    /// heave may be trusted a minute ahead while roll is not. Its end (0: not trusted at all) ...
+    pub series_horizon_s: [f64; 6 * MAX_VESSELS],
+    /// ... and its start. A vessel's span (`horizon_s`, `trusted_from_s`) is where every DOF that
+    /// moves enough to matter is trusted.
+    pub series_trusted_from_s: [f64; 6 * MAX_VESSELS],
 }
 
 /// Health of the daemon, published every cycle. 384 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
@@ -313,7 +319,7 @@ impl NavigationSample {
 
 impl ForecastHeader {
     /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
-    pub const TYPE_NAME: &'static str = "shipcast_ForecastHeader_v2";
+    pub const TYPE_NAME: &'static str = "shipcast_ForecastHeader_v3";
 }
 
 impl Status {
@@ -333,6 +339,28 @@ impl ForecastHeader {
         if b < MAX_VESSELS {
             self.trusted_from_s[b] = from_s;
             self.horizon_s[b] = to_s;
+            if to_s <= 0.0 {
+                for i in 6 * b..6 * b + 6 {
+                    self.set_series_span(i, 0.0, 0.0);
+                }
+            }
+        }
+    }
+
+    /// Series `i`'s own trusted span (6 per vessel), s of lead (both 0: not trusted).
+    pub fn set_series_span(&mut self, i: usize, from_s: f64, to_s: f64) {
+        if i < 6 * MAX_VESSELS {
+            self.series_trusted_from_s[i] = from_s;
+            self.series_horizon_s[i] = to_s;
+        }
+    }
+
+    /// Series `i`'s trusted span (from, to), s of lead ((0, 0): not trusted, or not sent).
+    pub fn series_span(&self, i: usize) -> (f64, f64) {
+        if i < 6 * MAX_VESSELS {
+            (self.series_trusted_from_s[i], self.series_horizon_s[i])
+        } else {
+            (0.0, 0.0)
         }
     }
 
@@ -391,6 +419,16 @@ pub fn check_forecast(h: &ForecastHeader, payload_len: usize) -> Result<(), Stri
             "forecast with trusted spans from {:?}",
             &h.trusted_from_s[..n_vessels]
         ));
+    }
+    let n_series = h.n_series as usize;
+    let spans = h.series_trusted_from_s[..n_series]
+        .iter()
+        .zip(&h.series_horizon_s[..n_series]);
+    if let Some((i, (from, to))) = spans
+        .enumerate()
+        .find(|(_, (f, t))| !(f.is_finite() && t.is_finite() && **f >= 0.0 && **t >= 0.0))
+    {
+        return Err(format!("forecast with series {i}'s trusted span {from} to {to} s"));
     }
     Ok(())
 }
@@ -507,6 +545,20 @@ mod tests {
                 },
                 22 * 12,
             ),
+            (
+                ForecastHeader {
+                    series_horizon_s: std::array::from_fn(|i| if i == 9 { f64::NAN } else { 1.0 }),
+                    ..good()
+                },
+                22 * 12,
+            ),
+            (
+                ForecastHeader {
+                    series_trusted_from_s: std::array::from_fn(|i| if i == 11 { -1.0 } else { 0.0 }),
+                    ..good()
+                },
+                22 * 12,
+            ),
             // the displacements without their standard deviations (a schema 1 payload)
             (good(), 11 * 12),
         ];
@@ -519,7 +571,7 @@ mod tests {
     fn layouts_are_what_the_docs_say() {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
-        assert_eq!(std::mem::size_of::<ForecastHeader>(), 128);
+        assert_eq!(std::mem::size_of::<ForecastHeader>(), 512);
         assert_eq!(std::mem::size_of::<Status>(), 384);
         assert_eq!(std::mem::size_of::<LinkStatus>(), 64);
     }

@@ -129,9 +129,11 @@ pub struct Engine {
     /// The last pose taken from navigation: (system heading, system origin, vessel velocity over
     /// ground), kept for when navigation goes stale.
     last_frame: Option<(f64, [f64; 2], [f64; 2])>,
-    /// The newest radar scans of one grid (at most `forecast.radar_snapshots`), and how they are
+    /// The newest radar scans of one grid (at most `forecast.radar_snapshots`), how many of the newest
+    /// the next inversion takes (`waves::window::window_scans` of the last field), and how they are
     /// inverted (the database's frequency band).
     scans: std::collections::VecDeque<message::Scan>,
+    radar_window: usize,
     radar_options: crate::waves::observe::GridOptions,
     /// Each vessel's motion estimator (its kept window of samples).
     hist: Vec<Estimator>,
@@ -207,6 +209,7 @@ impl Engine {
             nav_clock: vec![clock::SourceClock::default(); n_bodies],
             last_frame: None,
             scans: std::collections::VecDeque::new(),
+            radar_window: cfg.forecast.radar_snapshots as usize,
             radar_options: {
                 let (lo, hi) = model.db.omega_range();
                 crate::waves::observe::GridOptions {

@@ -27,7 +27,7 @@ impl Engine {
                 let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share && !unknown;
                 let mut values = values;
                 if unknown {
-                    self.unknown_start(&mut header, &mut values, &d.motion_sigma);
+                    self.unknown_start(&mut header, &mut values, &d.motion_sigma, &d.model_error);
                 }
                 if values.len() == 2 * n {
                     self.learn_model_mean(&header, &values[..n]);
@@ -83,8 +83,15 @@ impl Engine {
 
     /// A forecast that started vessels from rest for want of their motion: nothing of theirs is trusted
     /// (horizon 0), and their band is at least the error of a guess unrelated to the motion, twice
-    /// its variance (`motion_sigma`: the model's response to the whole sea), as for unknown waves.
-    fn unknown_start(&self, header: &mut ForecastHeader, values: &mut [f64], motion_sigma: &[f64]) {
+    /// its variance (the motion as the checks measured it, at least `motion_sigma`, the model's
+    /// response to the whole sea), as for unknown waves.
+    fn unknown_start(
+        &self,
+        header: &mut ForecastHeader,
+        values: &mut [f64],
+        motion_sigma: &[f64],
+        learnt: &crate::band::ModelErrorCurve,
+    ) {
         let per = header.steps as usize + 1;
         let n = per * header.n_series as usize;
         for (b, _) in self.job_unknown.iter().enumerate().filter(|(_, u)| **u) {
@@ -93,7 +100,9 @@ impl Engine {
                 continue;
             }
             for i in 6 * b..(6 * b + 6).min(header.n_series as usize) {
-                let floor = std::f64::consts::SQRT_2 * motion_sigma.get(i).copied().unwrap_or(f64::NAN);
+                // the motion as measured where the checks have seen it, and at least the model's
+                let model = motion_sigma.get(i).copied().unwrap_or(f64::NAN);
+                let floor = std::f64::consts::SQRT_2 * learnt.motion_sigma(i, model).max(model);
                 for s in &mut values[n + i * per..n + (i + 1) * per] {
                     // NaN (no band known) stays NaN
                     if floor.is_finite() && *s < floor {

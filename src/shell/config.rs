@@ -187,8 +187,9 @@ pub const BOUNDS: &[Bound] = &[
     positive("forecast.max_navigation_age_s", 3600.0, "s"),
     // at least a few fixes, at most ten minutes of a turn
     closed("forecast.navigation_window_s", 1.0, 600.0, "s"),
-    // two tell opposite directions apart; more than a minute of 2 s scans adds nothing
-    closed("forecast.radar_snapshots", 2.0, 32.0, ""),
+    // two tell opposite directions apart; two minutes of 2 s scans fill a 400 m blind zone at the
+    // slowest groups of a sea
+    closed("forecast.radar_snapshots", 2.0, 64.0, ""),
     // a model off by its own motion is no model
     closed("forecast.model_error", 0.0, 1.0, ""),
     // an expected error as large as the motion itself is no forecast

@@ -24,9 +24,10 @@
 //!   coverage, absent from logs before version 5 and for a field without them)
 //! - `/truth` (`shipcast.Motion`): like `/motion`, the simulator's true motion (absent from real logs)
 //! - `/forecast` (`shipcast.Forecast`): `{"issue_time_s", "dt_s", "steps", "flags", "wave_time_s",
-//!   "motion_time_s", "compute_ms", "horizon_s": [..], "trusted_from_s": [..], "values": [...],
-//!   "sigma": [...]}` (series-major as on the wire; `trusted_from_s` and `sigma`, the band's standard
-//!   deviations, absent from logs before version 4)
+//!   "motion_time_s", "compute_ms", "horizon_s": [..], "trusted_from_s": [..], "series_horizon_s":
+//!   [..], "series_trusted_from_s": [..], "values": [...], "sigma": [...]}` (series-major as on the
+//!   wire; `trusted_from_s` and `sigma`, the band's standard deviations, absent from logs before
+//!   version 4; each series' own span, before version 6)
 //! - `/navigation` (`shipcast.Navigation`): `{"vessel", "time_s", "east_m", "north_m", "heading_deg",
 //!   "sog_m_s", "cog_deg", "stw_m_s", "rot_deg_s", "valid"}` (as on the wire: compass degrees,
 //!   rate of turn positive to starboard; absent from logs before version 3)
@@ -53,8 +54,9 @@ use std::path::Path;
 /// The version of the log format this shipcast writes (channel metadata `shipcast_schema_version`);
 /// it reads this and every older one. What each version added: 2, JSON Schemas, UNIX log times, the
 /// `shipcast` metadata record, `/radar`; 3, `/navigation`, `/elevation`; 4, a forecast's `sigma` and
-/// `trusted_from_s`, a wave field's `window_s`; 5, a wave field's `inner_m` and `coverage_ranges_m`.
-pub const LOG_SCHEMA_VERSION: u32 = 5;
+/// `trusted_from_s`, a wave field's `window_s`; 5, a wave field's `inner_m` and `coverage_ranges_m`;
+/// 6, a forecast's `series_horizon_s` and `series_trusted_from_s`, a radar field's `window_s`.
+pub const LOG_SCHEMA_VERSION: u32 = 6;
 
 /// A vessel's motion sample (measured on `/motion`, true on `/truth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -186,6 +188,12 @@ pub struct ForecastRecord {
     /// Start of the trusted span per vessel, s of lead (absent before log version 4: 0).
     #[serde(default)]
     pub trusted_from_s: Vec<f64>,
+    /// Each series' own trusted span, s of lead: its end and its start (6 per vessel; absent
+    /// before log version 6: the vessel's, [`ForecastRecord::series_span`]).
+    #[serde(default)]
+    pub series_horizon_s: Vec<f64>,
+    #[serde(default)]
+    pub series_trusted_from_s: Vec<f64>,
     /// Series-major: 6 series per vessel (surge..yaw, m and rad), `steps + 1` values each.
     pub values: Vec<f64>,
     /// The band: a standard deviation per value, same layout (absent before log version 4: empty).
@@ -258,8 +266,22 @@ impl ForecastRecord {
             compute_ms: h.compute_ms,
             horizon_s: h.horizon_s[..nv].to_vec(),
             trusted_from_s: h.trusted_from_s[..nv].to_vec(),
+            series_horizon_s: h.series_horizon_s[..6 * nv].to_vec(),
+            series_trusted_from_s: h.series_trusted_from_s[..6 * nv].to_vec(),
             values: values.to_vec(),
             sigma: sigma.to_vec(),
+        }
+    }
+
+    /// Series `i`'s trusted span (from, to), s of lead: its own, or in a log without them its
+    /// vessel's ((0, 0): not trusted).
+    pub fn series_span(&self, i: usize) -> (f64, f64) {
+        match (self.series_trusted_from_s.get(i), self.series_horizon_s.get(i)) {
+            (Some(f), Some(t)) => (*f, *t),
+            _ => (
+                self.trusted_from_s.get(i / 6).copied().unwrap_or(0.0),
+                self.horizon_s.get(i / 6).copied().unwrap_or(0.0),
+            ),
         }
     }
 }
@@ -756,15 +778,19 @@ pub struct Read {
     pub warnings: Vec<String>,
 }
 
-/// Reads a log. A newer schema version is an error; a truncated or corrupt tail keeps every message
-/// before it (with a warning); an undecodable message is skipped (counted in a warning).
+/// Reads a log. A newer schema version is an error; a truncated or corrupt tail (a chunk whose CRC
+/// does not match) keeps every message before it (with a warning); an undecodable message is skipped
+/// (counted in a warning).
 pub fn read(path: &Path) -> Result<Read, Error> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Read {
         records: vec![],
         warnings: vec![],
     };
-    let stream = mcap::MessageStream::new_with_options(&bytes, mcap::read::Options::IgnoreEndMagic.into())
+    // a chunk whose CRC does not match is corrupt: its messages may decode to other numbers (a
+    // compressed chunk's corrupted literals are other digits), so it ends the readable part
+    let options = mcap::read::Options::IgnoreEndMagic | mcap::read::Options::ValidateChunkCrcs;
+    let stream = mcap::MessageStream::new_with_options(&bytes, options)
         .map_err(|e| format!("{}: not an MCAP log: {e}", path.display()))?;
     let mut skipped = 0usize;
     for m in stream {

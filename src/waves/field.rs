@@ -45,11 +45,14 @@ pub enum Region {
     /// What a radar's valid cells covered, seen from `centre_m` (earth frame): in each of
     /// [`COVERAGE_SECTORS`] equal sectors of direction (sector j spans j..j+1 times 360 / sectors deg,
     /// counterclockwise from east), the farthest valid cell, m (0: nothing seen that way); nothing
-    /// within `inner_m` of the centre was seen (a radar's blind zone).
+    /// within `inner_m` of the centre was seen (a radar's blind zone). The field was fitted to scans
+    /// from `window_s` before its time up to it (0: one scan, or not said): water that has moved into
+    /// the blind zone since was seen by an earlier scan of the window.
     Coverage {
         centre_m: [f64; 2],
         inner_m: f64,
         ranges_m: [f64; COVERAGE_SECTORS],
+        window_s: f64,
     },
 }
 
@@ -67,6 +70,7 @@ impl Region {
                 centre_m,
                 inner_m,
                 ranges_m,
+                ..
             } => {
                 let (dx, dy) = (p[0] - centre_m[0], p[1] - centre_m[1]);
                 let j = coverage_sector(dy.atan2(dx));
@@ -101,7 +105,8 @@ pub struct WaveField {
 /// log (`record::WavesRecord`); the components travel as rows `[omega_rad_s, direction_rad, re, im]`.
 /// Radius 0 = no region known (read back as [`Region::Everywhere`]); a negative radius = a wave probe
 /// at the reference point ([`Region::Point`]; a probe's field is referred to its point); depth 0 =
-/// infinite. `window_s`: a probe's fitted record, s (0: not said, or not a probe). A radar's view
+/// infinite. `window_s`: a probe's fitted record, or a radar's window of scans, s (0: not said, or one
+/// scan). A radar's view
 /// ([`Region::Coverage`], seen from the reference point): `inner_m` its blind zone (0: none) and
 /// `ranges_m` the farthest point seen per sector (None: the disc of `radius_m`, less the blind zone),
 /// `radius_m` then the farthest of them.
@@ -212,7 +217,7 @@ impl WaveField {
             depth_m: self.depth_m.unwrap_or(0.0),
             g_m_s2: self.g_m_s2,
             window_s: match self.region {
-                Region::Point { window_s, .. } => window_s,
+                Region::Point { window_s, .. } | Region::Coverage { window_s, .. } => window_s,
                 _ => 0.0,
             },
             inner_m,
@@ -229,8 +234,14 @@ impl WaveField {
 
     /// A field from the flat layout, validated (the inverse of [`Self::flat_header`] and
     /// [`Self::flat_rows`]; a coverage is seen from the reference point, and a disc with a blind zone
-    /// is a coverage of that radius all round).
+    /// or a window of scans is a coverage of that radius all round).
     pub fn from_flat(h: FlatHeader, rows: impl IntoIterator<Item = [f64; 4]>) -> Result<WaveField> {
+        // a window that is not a positive finite number is not said
+        let window_s = if h.window_s.is_finite() && h.window_s > 0.0 {
+            h.window_s
+        } else {
+            0.0
+        };
         let f = WaveField {
             components: rows
                 .into_iter()
@@ -244,11 +255,12 @@ impl WaveField {
             time_s: h.time_s,
             g_m_s2: h.g_m_s2,
             depth_m: (h.depth_m > 0.0).then_some(h.depth_m),
-            region: if h.radius_m > 0.0 && (h.ranges_m.is_some() || h.inner_m != 0.0) {
+            region: if h.radius_m > 0.0 && (h.ranges_m.is_some() || h.inner_m != 0.0 || window_s > 0.0) {
                 Region::Coverage {
                     centre_m: h.reference_m,
                     inner_m: h.inner_m,
                     ranges_m: h.ranges_m.unwrap_or([h.radius_m; COVERAGE_SECTORS]),
+                    window_s,
                 }
             } else if h.radius_m > 0.0 {
                 Region::Disc {
@@ -258,12 +270,7 @@ impl WaveField {
             } else if h.radius_m < 0.0 {
                 Region::Point {
                     at_m: h.reference_m,
-                    // a window that is not a positive finite number is not said
-                    window_s: if h.window_s.is_finite() && h.window_s > 0.0 {
-                        h.window_s
-                    } else {
-                        0.0
-                    },
+                    window_s,
                 }
             } else {
                 Region::Everywhere
@@ -486,6 +493,7 @@ mod tests {
                         600.0 + 5.0 * j as f64
                     }
                 }),
+                window_s: 62.0,
             },
         ] {
             let f = WaveField { region, ..field() };
@@ -541,7 +549,8 @@ mod tests {
             Region::Coverage {
                 centre_m: f.reference_m,
                 inner_m: 150.0,
-                ranges_m: [900.0; COVERAGE_SECTORS]
+                ranges_m: [900.0; COVERAGE_SECTORS],
+                window_s: 0.0,
             }
         );
         let bad = FlatHeader { inner_m: -1.0, ..h };

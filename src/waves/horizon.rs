@@ -1,9 +1,9 @@
 //! The predictable horizon (pure): how far ahead the waves reaching a vessel were inside the observed
-//! region at the observation time.
+//! region at the observation time (or, for a radar's window of scans, at one of its scans).
 //!
 //! A wave group of frequency w travelling along d reaches the vessel (moving at velocity u from its
 //! position at t0) at lead time t only if it was inside the observed region at t0: at
-//! p0 + (u - c_g(w) d) t. Each part of the field thus has a lead time t_c after which it is unknown;
+//! p0 + (u - c_g(w) d) t, or, a scan tau earlier in the window, at p0 + (u - c_g(w) d) t - c_g(w) d tau. Each part of the field thus has a lead time t_c after which it is unknown;
 //! the horizon is the lead time by which the unknown parts carry [`UNKNOWN_FRACTION`] of the variance
 //! (long waves, the fastest groups, go first), less the non-causal reach of the force RAO (the force at t
 //! depends on the waves up to that much later). For a disc of radius R around a stationary vessel and
@@ -82,7 +82,7 @@ pub fn of_field(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2],
                     rel,
                 )[1],
                 // the end of the span its water is inside it (behind a blind zone too)
-                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel)[1],
+                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel, [-cg * d[0], -cg * d[1]])[1],
                 Region::Point { at_m, .. } => {
                     // a probe: the group reaches the (stationary) vessel after travelling from it
                     let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
@@ -119,32 +119,56 @@ fn disc_span(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> [f64; 2] {
 }
 
 /// [`disc_span`] for a coverage region, marched in steps of [`COVERAGE_STEP_M`] or more: the first step
-/// inside, then the first outside after it ([0, 0]: never inside within reach).
-fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2]) -> [f64; 2] {
-    let Region::Coverage { ranges_m, centre_m, .. } = region else {
+/// seen, then the first not seen after it ([0, 0]: never seen within reach). The water at lead t is at
+/// `position + rel t` at the field's time; a scan `tau` earlier (up to the region's `window_s`) saw it
+/// at `position + rel t + back tau`, `back` the group's velocity reversed: a lead is seen when the
+/// water was inside the coverage at the field's time or at an earlier scan of its window (the region
+/// taken as it was at the field's time: the union of what the window's scans saw).
+fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64; 2]) -> [f64; 2] {
+    let Region::Coverage {
+        ranges_m,
+        centre_m,
+        window_s,
+        ..
+    } = *region
+    else {
         return [0.0, 0.0];
+    };
+    let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
+    let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
+    let step_m = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS);
+    let back_speed = back[0].hypot(back[1]);
+    let window_s = if window_s.is_finite() { window_s.max(0.0) } else { 0.0 };
+    let (taus, dtau) = if back_speed > 0.0 && window_s > 0.0 {
+        let d = step_m / back_speed;
+        (
+            (window_s / d).ceil() as usize,
+            window_s / (window_s / d).ceil().max(1.0),
+        )
+    } else {
+        (0, 0.0)
+    };
+    let seen = |t: f64| {
+        let p = [position[0] + rel[0] * t, position[1] + rel[1] * t];
+        (0..=taus).any(|j| {
+            let tau = j as f64 * dtau;
+            region.contains([p[0] + back[0] * tau, p[1] + back[1] * tau])
+        })
     };
     let speed = rel[0].hypot(rel[1]);
     if speed <= 0.0 {
-        return if region.contains(position) {
-            [0.0, f64::INFINITY]
-        } else {
-            [0.0, 0.0]
-        };
+        return if seen(0.0) { [0.0, f64::INFINITY] } else { [0.0, 0.0] };
     }
-    let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
-    let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
-    let dt = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS) / speed;
-    let at = |t: f64| region.contains([position[0] + rel[0] * t, position[1] + rel[1] * t]);
+    let dt = step_m / speed;
     let mut t = 0.0;
-    while !at(t) {
+    while !seen(t) {
         t += dt;
         if t * speed > reach {
             return [0.0, 0.0];
         }
     }
     let start = t;
-    while t * speed <= reach && at(t + dt) {
+    while t * speed <= reach && seen(t + dt) {
         t += dt;
     }
     [start, t]
@@ -152,7 +176,8 @@ fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2]) -> [f64; 2]
 
 /// For each component of a field, the lead times (s, from the field's time) over which the waves it
 /// brings to a vessel at `position_m` moving at `velocity_m_s` (earth frame) had been observed:
-/// inside the observed disc or coverage at the field's time, or past the probe within its fitted
+/// inside the observed disc or coverage at the field's time (a coverage: or at an earlier scan of its
+/// window), or past the probe within its fitted
 /// window (a probe whose window is not said: from 0). Known everywhere: [0, infinity).
 pub fn known_leads(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2]) -> Vec<[f64; 2]> {
     field
@@ -169,7 +194,7 @@ pub fn known_leads(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 
                     radius_m,
                     rel,
                 ),
-                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel),
+                Region::Coverage { .. } => coverage_span(&field.region, position_m, rel, [-cg * d[0], -cg * d[1]]),
                 Region::Point { at_m, window_s } => {
                     let along = d[0] * (position_m[0] - at_m[0]) + d[1] * (position_m[1] - at_m[1]);
                     let closing = cg - (velocity_m_s[0] * d[0] + velocity_m_s[1] * d[1]);
@@ -348,6 +373,7 @@ mod tests {
             centre_m: [0.0, 0.0],
             inner_m: 0.0,
             ranges_m: [1000.0; COVERAGE_SECTORS],
+            window_s: 0.0,
         };
         let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
         assert!(
@@ -358,6 +384,7 @@ mod tests {
             centre_m: [1500.0, 0.0],
             inner_m: 0.0,
             ranges_m: [1000.0; COVERAGE_SECTORS],
+            window_s: 0.0,
         };
         let k = known_leads(&field(cov), [0.0, 0.0], [0.0, 0.0]);
         assert!(
@@ -370,6 +397,7 @@ mod tests {
             centre_m: [0.0, 0.0],
             inner_m: 200.0,
             ranges_m: [1000.0; COVERAGE_SECTORS],
+            window_s: 0.0,
         };
         let f = field(cov);
         let k = known_leads(&f, [0.0, 0.0], [0.0, 0.0]);
@@ -379,6 +407,38 @@ mod tests {
         );
         let h = of_field(&f, [0.0, 0.0], [0.0, 0.0], 0.0);
         assert!((h.wave_horizon_s - 1000.0 / cg).abs() < 11.0 / cg, "{h:?}");
+    }
+
+    #[test]
+    fn a_window_of_scans_fills_the_blind_zone_with_what_earlier_scans_saw() {
+        use crate::waves::field::COVERAGE_SECTORS;
+        let field = |region| westward(region).0;
+        let cg = westward(Region::Everywhere).1;
+        let blind = |window_s: f64, ranges_m| Region::Coverage {
+            centre_m: [0.0, 0.0],
+            inner_m: 200.0,
+            ranges_m,
+            window_s,
+        };
+        let all_round = [1000.0; COVERAGE_SECTORS];
+        // the water inside the blind zone now crossed its edge 200 m / c_g ago: a window that long
+        // saw all of it, and the far edge is where it was
+        let k = known_leads(&field(blind(200.0 / cg + 2.0, all_round)), [0.0, 0.0], [0.0, 0.0]);
+        assert!(k[0][0] == 0.0 && (k[0][1] - 1000.0 / cg).abs() < 11.0 / cg, "{k:?}");
+        // a shorter window: the first leads' water was still in the blind zone at the oldest scan
+        let k = known_leads(&field(blind(10.0, all_round)), [0.0, 0.0], [0.0, 0.0]);
+        assert!((k[0][0] - (200.0 / cg - 10.0)).abs() < 11.0 / cg, "{k:?}");
+        // the waves come from the east (travelling west): a sector masked to the east was never seen,
+        // however long the window
+        let masked = std::array::from_fn(|j| {
+            if !(4..COVERAGE_SECTORS - 4).contains(&j) {
+                0.0
+            } else {
+                1000.0
+            }
+        });
+        let k = known_leads(&field(blind(600.0, masked)), [0.0, 0.0], [0.0, 0.0]);
+        assert_eq!(k[0], [0.0, 0.0]);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Phase-resolved wave fields (pure): components in a vessel's frame ([`WaveComponent`]), the dispersion
 //! relation, earth-frame fields ([`field`]), measured inputs turned into fields ([`observe`]: radar
 //! grids, probe records), sea states and their realizations ([`sea`]), the predictable horizon
-//! ([`horizon`]).
+//! ([`horizon`]), the radar window's length ([`window`]).
 //!
 //! Conventions (DESIGN.md section 1): a component is eta(x, y, t) = Re{ a exp(i(w t - k (x cos b +
 //! y sin b))) } with a complex (m), w > 0 the absolute frequency (rad/s), b the direction the wave travels
@@ -84,3 +84,4 @@ pub mod field;
 pub mod horizon;
 pub mod observe;
 pub mod sea;
+pub mod window;

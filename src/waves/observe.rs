@@ -267,6 +267,7 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
             // one has none)
             inner_m: (nearest_m - 0.5 * cell_m * std::f64::consts::SQRT_2).max(0.0),
             ranges_m,
+            window_s: grids.last().map_or(0.0, |g| g.time_s) - first.time_s,
         },
         ..local
     };

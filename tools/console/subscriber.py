@@ -25,7 +25,7 @@ import time
 
 import iceoryx2 as iox2
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 MAX_VESSELS = 4
 DOFS = ["surge", "sway", "heave", "roll", "pitch", "yaw"]
 FLAGS = [
@@ -52,7 +52,7 @@ FLAGS = [
 
 
 class ForecastHeader(ctypes.Structure):
-    """shipcast_ForecastHeader_v2 (128 bytes)."""
+    """shipcast_ForecastHeader_v3 (512 bytes)."""
 
     _fields_ = [
         ("schema_version", ctypes.c_uint32),
@@ -68,11 +68,13 @@ class ForecastHeader(ctypes.Structure):
         ("compute_ms", ctypes.c_double),
         ("horizon_s", ctypes.c_double * MAX_VESSELS),
         ("trusted_from_s", ctypes.c_double * MAX_VESSELS),
+        ("series_horizon_s", ctypes.c_double * (6 * MAX_VESSELS)),
+        ("series_trusted_from_s", ctypes.c_double * (6 * MAX_VESSELS)),
     ]
 
     @staticmethod
     def type_name() -> str:
-        return "shipcast_ForecastHeader_v2"
+        return "shipcast_ForecastHeader_v3"
 
 
 def decode(header, payload) -> dict:
@@ -107,6 +109,13 @@ def decode(header, payload) -> dict:
             {
                 "trusted_from_s": finite_or_none(header.trusted_from_s[v]),
                 "horizon_s": finite_or_none(header.horizon_s[v]),
+                "dof_spans_s": {
+                    dof: [
+                        finite_or_none(header.series_trusted_from_s[6 * v + d]),
+                        finite_or_none(header.series_horizon_s[6 * v + d]),
+                    ]
+                    for d, dof in enumerate(DOFS)
+                },
                 "heave_at_lead_s": at,
                 "heave_sigma_at_lead_s": sd,
             }

@@ -871,6 +871,7 @@ mod tests {
                 centre_m: [50.0, 20.0],
                 inner_m: 200.0,
                 ranges_m: std::array::from_fn(|j| if j < 10 { 0.0 } else { 990.0 }),
+                window_s: 30.0,
             },
         }
     }
@@ -900,6 +901,7 @@ mod tests {
             &WaveHeader {
                 n_sectors: 360,
                 inner_m: 200.0,
+                window_s: 30.0,
                 ..h
             },
             &v,
