@@ -16,7 +16,7 @@ use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel, Track};
 use crate::waves::field::{Region, WaveField};
 use crate::waves::observe::{Grid, GridFrame, GridOptions, from_scans};
 use crate::waves::sea::{SeaState, realize_all};
-use crate::waves::window::{MIN_WINDOW_SCANS, window_scans};
+use crate::waves::window::{MIN_WINDOW_SCANS, regrid, window_scans};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -134,8 +134,8 @@ pub struct NavFix {
 /// truth is not the forecaster's approximation).
 pub const TRUTH_PIECE_RAD: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
-/// The radar processor's map re-centres on the ship when the ship is this fraction of the radar's
-/// range from the map's centre (its snapshots must share one grid: the inversion starts over).
+/// The radar processor's map re-centres on the ship (to the nearest whole cell, its earlier snapshots
+/// moved onto the new grid) when the ship is this fraction of the radar's range from the map's centre.
 pub const MAP_RECENTRE_FRACTION: f64 = 0.1;
 
 /// The simulation: truth computed once, sensors sampled on demand.
@@ -340,18 +340,31 @@ impl Simulation {
         let r = self.spec.radar;
         let n = r.cells.max(8);
         let d = 2.0 * r.radius_m / n as f64;
-        // the map follows the ship in steps: its snapshots share one grid until it re-centres
+        // the map follows the ship in steps of whole cells: its earlier snapshots are moved onto the
+        // re-centred grid (the window goes on)
         let ship = self.pose(t_s).1;
         let o = match self.map_centre_m {
             Some(c) if (ship[0] - c[0]).hypot(ship[1] - c[1]) <= MAP_RECENTRE_FRACTION * r.radius_m => c,
-            _ => {
-                self.grids.clear();
-                ship
-            }
+            Some(c) => [
+                c[0] + ((ship[0] - c[0]) / d).round() * d,
+                c[1] + ((ship[1] - c[1]) / d).round() * d,
+            ],
+            None => ship,
         };
-        self.map_centre_m = Some(o);
         let xs: Vec<f64> = (0..n).map(|i| o[0] - r.radius_m + (i as f64 + 0.5) * d).collect();
         let ys: Vec<f64> = (0..n).map(|i| o[1] - r.radius_m + (i as f64 + 0.5) * d).collect();
+        if self.map_centre_m.is_some_and(|c| c != o) {
+            let earth = GridFrame {
+                origin_m: [0.0, 0.0],
+                orientation_rad: 0.0,
+            };
+            self.grids = self
+                .grids
+                .iter()
+                .filter_map(|g| regrid(g, earth, &xs, &ys, earth))
+                .collect();
+        }
+        self.map_centre_m = Some(o);
         let mut pts = Vec::with_capacity(n * n);
         for y in &ys {
             for x in &xs {

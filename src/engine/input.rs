@@ -4,7 +4,7 @@
 use super::estimator::{Refusal, Taken};
 use super::message::{Input, LinkStatus, MotionSample, NavigationSample, SCHEMA_VERSION, Scan, flags};
 use super::*;
-use crate::waves::window::{MIN_WINDOW_SCANS, window_scans};
+use crate::waves::window::{MIN_WINDOW_SCANS, regrid, window_scans};
 
 impl Engine {
     /// One input that arrived at `clock_s` (engine clock). Every stamp is judged against its source's
@@ -131,7 +131,9 @@ impl Engine {
             self.state_flags |= flags::CLOCK_STEP;
             self.scans.clear();
         }
-        // a sequence shares one grid at increasing times: another grid starts it again
+        // a sequence shares one grid at increasing times: another grid of the same lattice (a map
+        // re-centred on the ship by whole cells) takes the earlier scans moved onto it; any other
+        // starts it again
         let continues = self.scans.back().map(|last| {
             last.frame == scan.frame
                 && last.grid.x_m == scan.grid.x_m
@@ -153,7 +155,7 @@ impl Engine {
             return;
         }
         if continues == Some(false) {
-            self.scans.clear();
+            self.move_scans_onto(&scan);
         }
         self.scans.push_back(scan);
         self.waves_frozen = false;
@@ -197,6 +199,29 @@ impl Engine {
                 log_count(self.counters.rejected, &format!("radar scans not inverted: {e}"));
             }
         }
+    }
+
+    /// The kept scans moved onto `scan`'s grid (`waves::window::regrid`) when it is a later one of
+    /// their lattice; otherwise none are kept.
+    fn move_scans_onto(&mut self, scan: &Scan) {
+        let later = self
+            .scans
+            .back()
+            .is_some_and(|last| last.grid.time_s < scan.grid.time_s);
+        let moved: Option<Vec<Scan>> = later
+            .then(|| {
+                self.scans
+                    .iter()
+                    .map(|s| {
+                        regrid(&s.grid, s.frame, &scan.grid.x_m, &scan.grid.y_m, scan.frame).map(|grid| Scan {
+                            grid,
+                            frame: scan.frame,
+                        })
+                    })
+                    .collect()
+            })
+            .flatten();
+        self.scans = moved.unwrap_or_default().into();
     }
 
     /// A wave field: its size checked, then judged by the radar's clock.

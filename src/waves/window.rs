@@ -9,10 +9,18 @@
 //! which also sharpens the dispersion filter: the longer the window, the less of the blind zone's and
 //! the shadows' leakage passes as waves.
 //!
+//! A map that re-centres on a moving ship keeps its window: an older scan on the same lattice (the
+//! same spacing and orientation, origins a whole number of cells apart) is moved onto the new grid
+//! ([`regrid`]).
+//!
 //! Frames and units: earth frame, m, s, rad/s (DESIGN.md section 1).
 
 use super::field::{Region, WaveField, group_velocity};
 use super::horizon::UNKNOWN_FRACTION;
+use super::observe::{Grid, GridFrame};
+
+/// How far from a whole number of cells two grids' offset may be and still be one lattice, in cells.
+const LATTICE_TOLERANCE_CELLS: f64 = 1e-3;
 
 /// The window's length in crossings of the blind zone at the slowest group speed that matters. One
 /// crossing has seen the water the blind zone holds; more resolve the blind zone's own leakage (a hole
@@ -80,6 +88,50 @@ fn slow_frequency(field: &WaveField) -> Option<f64> {
     parts.last().map(|p| p.0)
 }
 
+/// An older scan moved onto another grid of the same lattice, so that a window of scans survives a map
+/// that re-centres on a moving ship: `old` (in `old_frame`) on the cells `x_m` x `y_m` of `frame`, NaN
+/// where it did not reach. None when the two are not one lattice: another orientation, another
+/// spacing, or origins not a whole number of cells apart.
+pub fn regrid(old: &Grid, old_frame: GridFrame, x_m: &[f64], y_m: &[f64], frame: GridFrame) -> Option<Grid> {
+    let spacing = |v: &[f64]| (v.len() >= 2).then(|| (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64);
+    let (dx, dy) = (spacing(x_m)?, spacing(y_m)?);
+    let same = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() <= LATTICE_TOLERANCE_CELLS * b.abs());
+    if !(same(spacing(&old.x_m), dx) && same(spacing(&old.y_m), dy))
+        || (old_frame.orientation_rad - frame.orientation_rad).abs() > 1e-9
+        || old.values.len() != old.x_m.len() * old.y_m.len()
+    {
+        return None;
+    }
+    // the old grid's first cell in the new grid's axes, in cells
+    let p = old_frame.to_earth(old.x_m[0], old.y_m[0]);
+    let q = frame.to_earth(x_m[0], y_m[0]);
+    let (s, c) = frame.orientation_rad.sin_cos();
+    let (ex, ey) = (p[0] - q[0], p[1] - q[1]);
+    let (sx, sy) = ((c * ex + s * ey) / dx, (-s * ex + c * ey) / dy);
+    if (sx - sx.round()).abs() > LATTICE_TOLERANCE_CELLS || (sy - sy.round()).abs() > LATTICE_TOLERANCE_CELLS {
+        return None;
+    }
+    let (sx, sy) = (sx.round() as i64, sy.round() as i64);
+    let (onx, ony) = (old.x_m.len() as i64, old.y_m.len() as i64);
+    let mut values = Vec::with_capacity(x_m.len() * y_m.len());
+    for iy in 0..y_m.len() as i64 {
+        for ix in 0..x_m.len() as i64 {
+            let (ox, oy) = (ix - sx, iy - sy);
+            values.push(if (0..onx).contains(&ox) && (0..ony).contains(&oy) {
+                old.values[(oy * onx + ox) as usize]
+            } else {
+                f64::NAN
+            });
+        }
+    }
+    Some(Grid {
+        x_m: x_m.to_vec(),
+        y_m: y_m.to_vec(),
+        time_s: old.time_s,
+        values,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,6 +176,44 @@ mod tests {
         assert_eq!(window_scans(&field(200.0, &[1.2]), 2.0, 8), 8);
         assert_eq!(window_scans(&field(0.0, &[0.7]), 2.0, 64), MIN_WINDOW_SCANS);
         assert_eq!(window_scans(&field(0.0, &[0.7]), 2.0, 2), 2);
+    }
+
+    #[test]
+    fn a_scan_moves_onto_a_grid_of_its_lattice_and_not_onto_another() {
+        let grid = |x0: f64, y0: f64| Grid {
+            x_m: (0..4).map(|i| x0 + 10.0 * i as f64).collect(),
+            y_m: (0..3).map(|i| y0 + 10.0 * i as f64).collect(),
+            time_s: 5.0,
+            values: (0..12).map(|i| i as f64).collect(),
+        };
+        let at = |x: f64, y: f64, turn: f64| GridFrame {
+            origin_m: [x, y],
+            orientation_rad: turn,
+        };
+        let old = grid(0.0, 0.0);
+        // the map moved one cell east and one north: the old cell (1, 1) is the new (0, 0)
+        let new = grid(0.0, 0.0);
+        let moved = regrid(&old, at(100.0, 50.0, 0.0), &new.x_m, &new.y_m, at(110.0, 60.0, 0.0)).unwrap();
+        assert_eq!(moved.time_s, 5.0);
+        assert_eq!(moved.values[0], old.values[4 + 1]);
+        assert_eq!(moved.values[4 + 2], old.values[2 * 4 + 3]);
+        // what the old grid did not reach is not seen
+        assert!(moved.values[3].is_nan() && moved.values[2 * 4].is_nan());
+        // the same map, offset in its own coordinates instead of its frame
+        let same = regrid(
+            &grid(-10.0, -10.0),
+            at(110.0, 60.0, 0.0),
+            &new.x_m,
+            &new.y_m,
+            at(110.0, 60.0, 0.0),
+        )
+        .unwrap();
+        assert_eq!(same.values[0], old.values[4 + 1]);
+        // half a cell apart, turned, or another spacing: another lattice
+        assert!(regrid(&old, at(105.0, 50.0, 0.0), &new.x_m, &new.y_m, at(100.0, 50.0, 0.0)).is_none());
+        assert!(regrid(&old, at(100.0, 50.0, 0.1), &new.x_m, &new.y_m, at(100.0, 50.0, 0.0)).is_none());
+        let coarse: Vec<f64> = (0..4).map(|i| 20.0 * i as f64).collect();
+        assert!(regrid(&old, at(0.0, 0.0, 0.0), &coarse, &new.y_m, at(0.0, 0.0, 0.0)).is_none());
     }
 
     #[test]
