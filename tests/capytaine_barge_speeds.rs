@@ -131,3 +131,27 @@ fn a_speed_beyond_the_databases_is_an_error_not_a_guess() {
     let one = load("direct_u3.toml");
     assert!(one.at_speed(5.0).is_ok());
 }
+
+#[test]
+fn a_speed_beyond_the_databases_is_said_while_the_model_is_the_old_one() {
+    // the daemon's computer: a rebuild at a speed beyond the databases fails once and keeps the old
+    // model, and says so while the speed stays there (the forecasts are then flagged
+    // model_speed_mismatch and trusted nowhere). Fails before: the failure was only logged.
+    use shipcast::rom::{RomOptions, TimeModel, Track};
+    let set = load("system.toml");
+    let model = TimeModel::new(&set.at_speed(0.0).unwrap(), RomOptions::default()).unwrap();
+    let cfg = shipcast::shell::config::load(&repo("config/shipcast.toml")).unwrap();
+    let mut c = shipcast::engine::Computer::new(model, &set, &cfg);
+    let at = |u: f64| Some(Track::straight(u));
+    assert!(c.at_speed(at(2.0)).is_ok());
+    assert!(!c.speed_mismatch(at(2.0)));
+    let e = c.at_speed(at(5.0)).unwrap_err();
+    assert!(e.contains("5 m/s"), "{e}");
+    assert!(c.speed_mismatch(at(5.0)));
+    // not tried again at the same speed, and still said
+    assert!(c.at_speed(at(5.0)).is_ok());
+    assert!(c.speed_mismatch(at(5.0)));
+    // back within the databases: the model serves again
+    assert!(c.at_speed(at(2.0)).is_ok());
+    assert!(!c.speed_mismatch(at(2.0)));
+}

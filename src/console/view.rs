@@ -307,6 +307,10 @@ fn flag_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
         ),
         ("waves_implausible", "Radar: a field that is not a sea was refused"),
         (
+            "model_speed_mismatch",
+            "Model not rebuilt for this speed (beyond its databases): not trusted",
+        ),
+        (
             "model_error_unchecked",
             "Learning the model's error: no lead trusted until forecasts are checked",
         ),

@@ -105,16 +105,16 @@ impl Computer {
 
     /// The model at the speed a job's track asks for, rebuilt when the system has speed terms and the
     /// speed moved to another step of [`MODEL_SPEED_STEP_M_S`]. An error (a speed beyond the databases')
-    /// keeps the model it had, and is reported once per speed step.
-    fn at_speed(&mut self, track: Option<Track>) -> Result<(), String> {
+    /// keeps the model it had, and is reported once per speed step; [`Self::speed_mismatch`] says so
+    /// while the speed stays there.
+    pub fn at_speed(&mut self, track: Option<Track>) -> Result<(), String> {
         let Some((sys, opts)) = &self.rebuild else {
             return Ok(());
         };
-        let want = (track.map_or(0.0, |t| t.speed_m_s) / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
-        // a speed between two steps keeps the model it has (no rebuild per forecast on noise)
-        let speed = track.map_or(0.0, |t| t.speed_m_s);
-        let near = (speed - self.model.opts.speed_m_s).abs() <= MODEL_SPEED_HYSTERESIS * MODEL_SPEED_STEP_M_S;
-        if near || (want - self.model.opts.speed_m_s).abs() < 1e-9 || self.failed_speed == Some(want) {
+        let Some(want) = self.wanted_speed(track) else {
+            return Ok(());
+        };
+        if self.failed_speed == Some(want) {
             return Ok(());
         }
         // tried once per speed step: an error is logged once, the model kept
@@ -142,11 +142,30 @@ impl Computer {
         Ok(())
     }
 
+    /// The speed step a track asks the model to be rebuilt at (None: the model it has serves: no speed
+    /// terms, or a speed within [`MODEL_SPEED_HYSTERESIS`] steps of the model's).
+    fn wanted_speed(&self, track: Option<Track>) -> Option<f64> {
+        self.rebuild.as_ref()?;
+        let speed = track.map_or(0.0, |t| t.speed_m_s);
+        let want = (speed / MODEL_SPEED_STEP_M_S).round() * MODEL_SPEED_STEP_M_S;
+        // a speed between two steps keeps the model it has (no rebuild per forecast on noise)
+        let near = (speed - self.model.opts.speed_m_s).abs() <= MODEL_SPEED_HYSTERESIS * MODEL_SPEED_STEP_M_S;
+        (!near && (want - self.model.opts.speed_m_s).abs() >= 1e-9).then_some(want)
+    }
+
+    /// Whether the model is not the one a track's speed asks for: its rebuild at that speed failed
+    /// ([`Self::at_speed`]), and forecasts at that speed are the old model's.
+    pub fn speed_mismatch(&self, track: Option<Track>) -> bool {
+        self.wanted_speed(track)
+            .is_some_and(|want| self.failed_speed == Some(want))
+    }
+
     /// Runs one job; `elapsed_ms` measures its compute time (the shell passes a clock).
     pub fn run(&mut self, job: Job, elapsed_ms: impl Fn() -> f64) -> Done {
         if let Err(e) = self.at_speed(job.track) {
-            tracing::warn!("{e}");
+            tracing::warn!("{e}: forecasts keep the model they have, trusted nowhere");
         }
+        let mismatch = self.speed_mismatch(job.track);
         let result = self.forecast(&job).map(|(values, steps, dropped, quasi_static)| {
             let spread = self.band(&job, steps);
             (values, steps, dropped, quasi_static, spread)
@@ -186,13 +205,17 @@ impl Computer {
                 if quasi_static > 0 {
                     header.flags |= flags::QUASI_STATIC_WAVES;
                 }
+                if mismatch {
+                    header.flags |= flags::MODEL_SPEED_MISMATCH;
+                    header.untrust_all();
+                }
                 Done {
                     header,
                     values: Some(values),
                     compute_ms,
                     error: None,
                     dropped_wave_share,
-                    teaches: job.trustworthy && !motion_sigma.is_empty(),
+                    teaches: job.trustworthy && !motion_sigma.is_empty() && !mismatch,
                     motion_sigma,
                     model_error: job.model_error,
                     start_var: job.start_var,

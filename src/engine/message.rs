@@ -91,6 +91,9 @@ pub mod flags {
     /// highest seas, a component steeper than a wave can be, or a jump over the last fields no sea
     /// makes. The forecasts keep the last field taken.
     pub const WAVES_IMPLAUSIBLE: u32 = 262_144;
+    /// The model could not be rebuilt for the forward speed (a speed beyond the databases'): the
+    /// forecast is the model's at the speed it was built for, and nothing is trusted.
+    pub const MODEL_SPEED_MISMATCH: u32 = 524_288;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -114,6 +117,7 @@ pub mod flags {
             (MODEL_ERROR_UNCHECKED, "model_error_unchecked"),
             (WAVES_FROZEN, "waves_frozen"),
             (WAVES_IMPLAUSIBLE, "waves_implausible"),
+            (MODEL_SPEED_MISMATCH, "model_speed_mismatch"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)

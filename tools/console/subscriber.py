@@ -48,6 +48,7 @@ FLAGS = [
     "model_error_unchecked",
     "waves_frozen",
     "waves_implausible",
+    "model_speed_mismatch",
 ]
 
 
