@@ -424,21 +424,6 @@ fn a_span_trusts_no_lead_its_model_error_has_not_been_checked_at() {
         &opts(moving),
     );
     assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 0.0));
-    let mut m = ModelError::new(0.15, vec![0.0; 6]);
-    let prior = ModelErrorCurve::prior(0.15, 6);
-    let (dt, n) = (0.5, 21);
-    let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
-    for c in 0..200 {
-        let t0 = c as f64;
-        let mut values = vec![0.0; 6 * n];
-        for k in 0..n {
-            values[2 * n + k] = motion(t0 + k as f64 * dt) - if k > 0 { 0.1 } else { 0.0 };
-        }
-        m.record(t0, dt, (&values, &vec![0.0; 6 * n]), &[1.0; 6], &prior, (&[], &[]));
-        m.observe(t0, |at| {
-            Some((0..6).map(|i| if i == 2 { motion(at) } else { 0.0 }).collect())
-        });
-    }
     let s = spread(
         &flat_table(6, 1.0),
         &[],
@@ -449,7 +434,7 @@ fn a_span_trusts_no_lead_its_model_error_has_not_been_checked_at() {
         None,
         40,
         0.5,
-        &opts(m.curve()),
+        &opts(checked_forecasts(&[(2, 0.1)])),
     );
     assert_eq!((s.from_s[0], s.to_s[0]), (0.0, 10.0));
 }
@@ -565,29 +550,8 @@ fn each_series_has_its_own_span_and_one_that_errs_does_not_shorten_the_others() 
     // heave (1 m) forecast within 0.1 m, pitch (1 rad) off by 0.9 rad from 0.5 s on, sway still:
     // the vessel is trusted only as far as pitch allows, heave and sway throughout (fails before:
     // one span per vessel)
-    let mut m = ModelError::new(0.15, vec![0.0; 6]);
-    let prior = ModelErrorCurve::prior(0.15, 6);
-    let (dt, n) = (0.5, 21);
-    let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
-    for c in 0..200 {
-        let t0 = c as f64;
-        let mut values = vec![0.0; 6 * n];
-        for k in 0..n {
-            let err = if k > 0 { 1.0 } else { 0.0 };
-            values[2 * n + k] = motion(t0 + k as f64 * dt) - 0.1 * err;
-            values[4 * n + k] = motion(t0 + k as f64 * dt) - 0.9 * err;
-        }
-        m.record(t0, dt, (&values, &vec![0.0; 6 * n]), &[1.0; 6], &prior, (&[], &[]));
-        m.observe(t0, |at| {
-            Some(
-                (0..6)
-                    .map(|i| if i == 2 || i == 4 { motion(at) } else { 0.0 })
-                    .collect(),
-            )
-        });
-    }
     let opts = SpreadOptions {
-        model_error: m.curve(),
+        model_error: checked_forecasts(&[(2, 0.1), (4, 0.9)]),
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
@@ -598,4 +562,38 @@ fn each_series_has_its_own_span_and_one_that_errs_does_not_shorten_the_others() 
     assert_eq!((s.series_from_s[1], s.series_to_s[1]), (0.0, 10.0));
     assert!(s.series_to_s[4] < 10.0, "{:?}", s.series_to_s);
     assert_eq!(s.series_from_s.len(), 6);
+}
+
+/// The model error learnt from 200 forecasts of 10 s (dt 0.5 s) checked against a motion of +-1 that
+/// flips every second, each series of `errors` (index, error) moving so and forecast off by its error
+/// from the first step on, the others still and forecast still.
+fn checked_forecasts(errors: &[(usize, f64)]) -> ModelErrorCurve {
+    let mut m = ModelError::new(0.15, vec![0.0; 6]);
+    let prior = ModelErrorCurve::prior(0.15, 6);
+    let (dt, n) = (0.5, 21);
+    let motion = |t: f64| if t.round() as i64 % 2 == 0 { 1.0 } else { -1.0 };
+    for c in 0..200 {
+        let t0 = c as f64;
+        let mut values = vec![0.0; 6 * n];
+        for &(i, e) in errors {
+            for k in 0..n {
+                values[i * n + k] = motion(t0 + k as f64 * dt) - if k > 0 { e } else { 0.0 };
+            }
+        }
+        m.record(t0, dt, (&values, &vec![0.0; 6 * n]), &[1.0; 6], &prior, (&[], &[]));
+        m.observe(t0, |at| {
+            Some(
+                (0..6)
+                    .map(|i| {
+                        if errors.iter().any(|(j, _)| *j == i) {
+                            motion(at)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect(),
+            )
+        });
+    }
+    m.curve()
 }
