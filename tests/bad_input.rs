@@ -408,6 +408,27 @@ fn period_s_of_1e20_is_refused() {
     );
 }
 
+/// Regression: a period of 1e400 (beyond an f64) was refused as "floating-point number overflowed"
+/// without the key or the line.
+#[test]
+fn a_number_beyond_a_float_is_refused_naming_its_key_and_line() {
+    refused(
+        config_with("forecast", "period_s", "1e400"),
+        &["forecast.period_s", "shipcast.toml:", "overflow"],
+    );
+}
+
+/// Regression: `SHIPCAST_FORECAST__PERIOD_S=-1` was blamed on the config file.
+#[test]
+fn a_value_out_of_bounds_from_the_environment_names_the_variable() {
+    let err = config_with_env("forecast", "period_s", "1.0", &[("SHIPCAST_FORECAST__PERIOD_S", "-1")])
+        .expect_err("the configuration was accepted");
+    assert!(
+        err.contains("environment variable SHIPCAST_FORECAST__PERIOD_S=\"-1\"") && err.contains("forecast.period_s"),
+        "{err}"
+    );
+}
+
 /// Regression: a period of 1e-12 s once panicked.
 #[test]
 fn period_s_of_1e_12_is_refused() {

@@ -38,12 +38,9 @@ pub fn load_with_env(path: &Path, env: &[(String, String)]) -> Result<ShipcastCo
             .and_then(|raw| raw.try_deserialize())
             .map_err(|e| e.to_string())
     };
-    let mut cfg = build(&[]).map_err(|msg| Error::Read {
-        file: file.clone(),
-        msg,
-    })?;
-    // the `config` crate coerces types (a boolean where a number is expected is 0 or 1): the file
-    // again with the TOML types as written, and no boolean in a variable for a numeric key
+    // the file with the TOML types as written first (the `config` crate coerces types, a boolean
+    // where a number is expected is 0 or 1, and names neither the key nor the line of a number
+    // beyond a float's range), and no boolean in a variable for a numeric key
     let text = std::fs::read_to_string(path).map_err(|e| Error::Read {
         file: file.clone(),
         msg: e.to_string(),
@@ -56,6 +53,10 @@ pub fn load_with_env(path: &Path, env: &[(String, String)]) -> Result<ShipcastCo
             msg: e.message().to_string(),
         });
     }
+    let mut cfg = build(&[]).map_err(|msg| Error::Read {
+        file: file.clone(),
+        msg,
+    })?;
     for (k, v) in &vars {
         let key = k[ENV_PREFIX.len()..].to_ascii_lowercase().replace("__", ".");
         let word = v.trim().to_ascii_lowercase();
@@ -88,10 +89,19 @@ pub fn load_with_env(path: &Path, env: &[(String, String)]) -> Result<ShipcastCo
     }
     cfg.dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     cfg.path = path.to_path_buf();
-    validate(&cfg).map_err(|(key, msg)| Error::Key {
-        file: file.clone(),
-        key,
-        msg,
+    validate(&cfg).map_err(|(key, msg)| {
+        // a value an environment variable set is the variable's, not the file's
+        let from_env = vars
+            .iter()
+            .find(|(k, _)| k[ENV_PREFIX.len()..].to_ascii_lowercase().replace("__", ".") == key);
+        Error::Key {
+            file: from_env.map_or_else(
+                || file.clone(),
+                |(k, v)| format!("environment variable {k}={v:?} (overlaying {file})"),
+            ),
+            key,
+            msg,
+        }
     })?;
     Ok(cfg)
 }
