@@ -73,16 +73,7 @@ impl Channel {
     /// pitch of a point are not independent); display units. Empty when `sigma` is.
     pub fn sigma_along<S: AsRef<[f64]>>(&self, ext: &External, sigma: &[S]) -> Vec<f64> {
         let n = sigma.iter().map(|s| s.as_ref().len()).min().unwrap_or(0);
-        // the channel is linear in the displacements (small rotations): its gradient once
-        let zero = vec![0.0; sigma.len()];
-        let base = self.value(ext, &zero);
-        let gradient: Vec<f64> = (0..sigma.len())
-            .map(|i| {
-                let mut x = zero.clone();
-                x[i] = 1.0;
-                (self.value(ext, &x) - base).abs()
-            })
-            .collect();
+        let gradient = self.gradient(ext, sigma.len());
         (0..n)
             .map(|k| {
                 gradient
@@ -95,17 +86,25 @@ impl Channel {
             .collect()
     }
 
-    /// The series (6 per vessel, of `n_series`) the channel's value changes with.
-    pub fn series(&self, ext: &External, n_series: usize) -> Vec<usize> {
+    /// |d value / d x_i| for each of `n_series` series: the channel is linear in the displacements
+    /// (small rotations), so one unit step of each from rest.
+    fn gradient(&self, ext: &External, n_series: usize) -> Vec<f64> {
         let zero = vec![0.0; n_series];
         let base = self.value(ext, &zero);
         (0..n_series)
-            .filter(|&i| {
+            .map(|i| {
                 let mut x = zero.clone();
                 x[i] = 1.0;
-                let d = self.value(ext, &x) - base;
-                d.is_finite() && d != 0.0
+                (self.value(ext, &x) - base).abs()
             })
+            .collect()
+    }
+
+    /// The series (6 per vessel, of `n_series`) the channel's value changes with.
+    pub fn series(&self, ext: &External, n_series: usize) -> Vec<usize> {
+        let gradient = self.gradient(ext, n_series);
+        (0..n_series)
+            .filter(|&i| gradient[i].is_finite() && gradient[i] > 0.0)
             .collect()
     }
 
