@@ -22,4 +22,5 @@ pub mod settings;
 pub mod shell;
 pub mod sim;
 pub mod skill;
+pub mod tuning;
 pub mod waves;

@@ -108,6 +108,9 @@ pub struct ForecastConfig {
     pub drift_window_s: f64,
     /// Motion samples kept per vessel beyond the radiation memory, s.
     pub history_margin_s: f64,
+    /// Tune each vessel's roll damping and natural frequency in situ from the daemon's own past
+    /// forecasts against the measured roll ([`crate::tuning`]).
+    pub tune_roll: bool,
     /// Of a received wave field, the largest components holding this fraction of its variance are kept
     /// (a radar inversion has one per wavenumber bin, mostly noise; the cost is linear in their number).
     pub wave_variance_kept: f64,
@@ -165,6 +168,7 @@ impl Default for ForecastConfig {
             max_navigation_age_s: 5.0,
             navigation_window_s: 30.0,
             radar_snapshots: 48,
+            tune_roll: true,
             model_error: 0.15,
             trusted_nrmse: 0.6,
         }

@@ -159,3 +159,22 @@ fn a_scenario_history_beyond_the_longest_run_is_refused_with_the_key() {
     assert!(!ok);
     assert!(err.contains("history_s") && err.contains("at most 3600 s"), "{err}");
 }
+
+/// Was: `run` started (and forecast) with an `[operation]` channel the system does not have; only a
+/// console or a report said so, later.
+#[test]
+fn run_refuses_an_operation_channel_the_system_does_not_have() {
+    let dir = scratch_dir("cli-channel");
+    let cfg = config_with_system(&dir, repo("config/vessels/ship/system.toml").to_str().unwrap());
+    let text = std::fs::read_to_string(&cfg).unwrap();
+    std::fs::write(
+        &cfg,
+        format!("{text}\n[operation]\nchannels = [{{ name = \"carrier.rool\", limit = 2.0 }}]\n"),
+    )
+    .unwrap();
+    let (ok, _, err) = shipcast(&["run", "--config", cfg.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("operation.channels[0].name") && err.contains("rool"),
+        "{err}"
+    );
+}

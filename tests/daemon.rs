@@ -771,3 +771,73 @@ fn the_daemon_loop_runs_in_process_and_stops_on_its_shutdown_future() {
     assert_eq!(statuses(&got, 0), 1, "the last status says the daemon stopped");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Was: `WATCHDOG=1` went to systemd on every tick whatever the compute thread did, so a computation
+/// that never ends kept the service from being restarted. Now the watchdog is fed on status-only ticks
+/// and while forecasts finish, and no longer once one is outstanding past the watchdog's interval less
+/// two periods. The hang is injected with `SHIPCAST_FAULT=compute-hang`; systemd is a datagram socket.
+#[test]
+fn a_hung_computation_is_no_longer_fed_to_the_watchdog() {
+    use std::os::unix::net::UnixDatagram;
+    let dir = crate::util::scratch_dir("daemon-hang");
+    let cfg = config(&dir, "hang", "");
+    let sock_path = dir.join("notify.sock");
+    let _ = std::fs::remove_file(&sock_path);
+    let sock = UnixDatagram::bind(&sock_path).unwrap();
+    sock.set_read_timeout(Some(Duration::from_millis(100))).unwrap();
+    // systemd names the pid the watchdog is for: the shell's own, which exec hands to shipcast
+    let mut d = Interrupting(
+        Command::new("sh")
+            .args([
+                "-c",
+                "WATCHDOG_PID=$$ exec \"$0\" run --config \"$1\"",
+                bin(),
+                cfg.to_str().unwrap(),
+            ])
+            .env(shipcast::shell::daemon::FAULT_ENV, "compute-hang")
+            .env("NOTIFY_SOCKET", &sock_path)
+            .env("WATCHDOG_USEC", "3000000")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("shipcast starts"),
+    );
+    let t = Instant::now();
+    let mut pings = vec![];
+    let listen = |until_s: f64, pings: &mut Vec<f64>| {
+        let mut buf = [0u8; 256];
+        while t.elapsed().as_secs_f64() < until_s {
+            if let Ok(n) = sock.recv(&mut buf)
+                && String::from_utf8_lossy(&buf[..n]).contains("WATCHDOG=1")
+            {
+                pings.push(t.elapsed().as_secs_f64());
+            }
+        }
+    };
+    // no inputs yet: status-only ticks, each a ping (once the model is built)
+    listen(8.0, &mut pings);
+    assert!(pings.len() >= 3, "pings before any input: {pings:?}");
+    let _sim = simulator(&cfg, "60", &[]);
+    listen(30.0, &mut pings);
+    let last = pings.last().copied().unwrap_or(0.0);
+    assert!(
+        d.0.try_wait().unwrap().is_none(),
+        "the daemon itself runs on (systemd ends it)"
+    );
+    assert!(
+        30.0 - last > 10.0,
+        "the watchdog was fed {:.1} s before the end, with the compute thread hung ({} pings, the last: {:?})",
+        30.0 - last,
+        pings.len(),
+        &pings[pings.len().saturating_sub(5)..]
+    );
+    drop(_sim);
+    let mut stderr = d.0.stderr.take().unwrap();
+    drop(d);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut err).unwrap();
+    assert!(
+        err.contains("hung") && err.contains("watchdog is no longer fed"),
+        "{err}"
+    );
+}

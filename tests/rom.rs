@@ -615,3 +615,42 @@ fn a_diverging_state_is_reported_with_its_dof_and_time() {
         "{err}"
     );
 }
+
+/// A model adjusted by nothing steps as the built one; one adjusted by a row's damping and stiffness
+/// is the model built with them (the step's matrices agree); a row out of range is refused.
+#[test]
+fn an_adjusted_model_is_the_model_built_with_the_change() {
+    use shipcast::rom::adjust::RowChange;
+    let sys = load("config/vessels/barge/system.toml");
+    let opts = RomOptions::default();
+    let model = TimeModel::new(&sys, opts).unwrap();
+    let same = model.adjusted(&[]).unwrap();
+    assert_eq!(same.cols_s_inv, model.cols_s_inv);
+    let row = model.labels.iter().position(|l| l.ends_with("roll")).unwrap();
+    let i = model.active[row];
+    let (db44, dc44) = (1.0e7, 2.0e7);
+    let mut sys2 = sys.clone();
+    sys2.spec.bodies[i / 6].linear_damping[(i % 6, i % 6)] += db44;
+    sys2.spec.bodies[i / 6].linear_stiffness[(i % 6, i % 6)] += dc44;
+    let rebuilt = TimeModel::new(&sys2, opts).unwrap();
+    let adj = model
+        .adjusted(&[RowChange {
+            row,
+            damping: db44,
+            stiffness: dc44,
+            ..RowChange::default()
+        }])
+        .unwrap();
+    for (a, b) in adj.cols_s_inv.iter().zip(&rebuilt.cols_s_inv) {
+        assert!((a - b).abs() <= 1e-9 * (1.0 + b.abs()), "{a} vs {b}");
+    }
+    assert!((adj.damping[(row, row)] - rebuilt.damping[(row, row)]).abs() <= 1e-6 * db44);
+    assert!(
+        model
+            .adjusted(&[RowChange {
+                row: 99,
+                ..RowChange::default()
+            }])
+            .is_err()
+    );
+}

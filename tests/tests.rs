@@ -26,6 +26,7 @@ mod rom;
 mod sim_truth;
 mod tidy;
 mod trust;
+mod tuning;
 mod two_ship_demo;
 mod underway;
 mod waves_fields;

@@ -713,3 +713,37 @@ proptest::proptest! {
         }
     }
 }
+
+/// Was: while every vessel's motion was stale (a stalled stream) the status said `no_waves` and
+/// `stale_waves` with a wave age of 1.6 s: the waves' age was judged against no motion at all (an
+/// infinite start time). Now it is judged against the newest motion there is.
+#[test]
+fn a_motion_stall_does_not_call_fresh_waves_stale() {
+    let l = log();
+    let t0 = start(&l.records);
+    let stall = (t0 + FAULT_AT_S, t0 + FAULT_AT_S + 10.0);
+    let records: Vec<(f64, Record)> = l
+        .records
+        .iter()
+        .filter(|(t, r)| !(matches!(r, Record::Motion(_)) && *t > stall.0 && *t < stall.1))
+        .cloned()
+        .collect();
+    let run = drive(&records);
+    let stalled: Vec<&Status> = run
+        .statuses
+        .iter()
+        .filter(|s| s.flags & flags::STALE_MOTION != 0 && s.time_s > stall.0 - 1.0)
+        .collect();
+    assert!(stalled.len() >= 3, "the stall is seen: {}", stalled.len());
+    for s in stalled {
+        if (0.0..5.0).contains(&s.wave_age_s) {
+            assert_eq!(
+                s.flags & (flags::NO_WAVES | flags::STALE_WAVES),
+                0,
+                "{:?} with waves {:.1} s old",
+                flags::names(s.flags),
+                s.wave_age_s
+            );
+        }
+    }
+}

@@ -64,6 +64,10 @@ pub struct WatchArgs {
 
 pub fn run(cfg: ShipcastConfig) -> Result<()> {
     let sys = load_system(&cfg)?;
+    // the consoles and reports read `[operation]` from the same file: a channel the system does not
+    // have is the file's error, said at start and not at the first console
+    let vessels: Vec<String> = sys.spec.bodies.iter().map(|b| b.name.clone()).collect();
+    cfg.operation_channels(&vessels, &sys.spec.external, &cfg.path)?;
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
@@ -633,6 +637,13 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
             "roll_deg": finite(b[1].to_degrees()),
             "pitch_deg": finite(b[2].to_degrees()),
         })).collect::<Vec<_>>(),
+        // the in-situ roll tuning in force (fractions; src/tuning/)
+        "roll_tuning": s.roll_tuning.iter().take(n_vessels).map(|t| serde_json::json!({
+            "damping_fraction": finite(t[0]),
+            "quadratic_fraction": finite(t[1]),
+            "frequency_correction": finite(t[2]),
+        })).collect::<Vec<_>>(),
+        "roll_tuning_converged": s.roll_tuning_converged == 1,
         // the ship-to-ship link: null when none runs
         "link": (s.link_state != shipcast::shell::ipc::wire::link_state::NONE).then(|| serde_json::json!({
             "up": s.link_state == shipcast::shell::ipc::wire::link_state::UP,

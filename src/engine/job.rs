@@ -35,6 +35,8 @@ pub struct Job {
     /// The frame's track from t0 (speed and turn from navigation; None: keeping station).
     pub(super) track: Option<Track>,
     pub(super) header: ForecastHeader,
+    /// What the in-situ tuning takes from this tick (None: tuning is off).
+    pub(super) tune: Option<super::tune::TuneInput>,
 }
 
 /// A job's result.
@@ -57,11 +59,19 @@ pub struct Done {
     /// The forecast may teach the model error: its waves were trusted and its band known (a forecast
     /// with no trusted span teaches all the same: its error is the model's).
     pub teaches: bool,
+    /// A round of the in-situ roll tuning finished since the last job ([`crate::tuning`]).
+    pub tuning: Option<crate::tuning::TunerReport>,
 }
 
 /// Runs jobs: the model and a reusable forecaster (the compute thread live, inline in replay).
 pub struct Computer {
+    /// The model forecasts run with: `base` with the in-situ tuning applied.
     model: TimeModel,
+    /// The model as built (at its speed), before the tuning.
+    base: TimeModel,
+    /// The in-situ roll tuning (None: off, or no vessel's roll can be tuned) and its work between
+    /// jobs ([`Computer::tune`]).
+    tuning: super::tune::Tuning,
     /// The model's response for the band (None: it could not be made; nothing is trusted then).
     table: Option<ResponseTable>,
     trusted_nrmse: f64,
@@ -91,6 +101,8 @@ impl Computer {
             });
         let n_bodies = sys.spec.bodies.len();
         Computer {
+            tuning: super::tune::Tuning::new(&model, cfg),
+            base: model.clone(),
             rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
             failed_speed: None,
             table: response_table(&model),
@@ -135,6 +147,8 @@ impl Computer {
             "model rebuilt for the forward speed (its speed terms)"
         );
         self.table = response_table(&model);
+        self.tuning.reset(&model);
+        self.base = model.clone();
         self.model = model;
         self.failed_speed = None;
         // its workspace holds the old model's kernel spectra
@@ -166,6 +180,14 @@ impl Computer {
             tracing::warn!("{e}: forecasts keep the model they have, trusted nowhere");
         }
         let mismatch = self.speed_mismatch(job.track);
+        let tuning = self.tuning.take(job.t0_s, job.tune.as_ref(), || crate::tuning::Case {
+            t0_s: job.t0_s,
+            x0: job.x0.clone(),
+            v0: job.v0.clone(),
+            velocities: job.velocities.clone(),
+            waves: job.waves.clone(),
+            track: job.track,
+        });
         let result = self.forecast(&job).map(|(values, steps, dropped, quasi_static)| {
             let spread = self.band(&job, steps);
             (values, steps, dropped, quasi_static, spread)
@@ -216,6 +238,7 @@ impl Computer {
                     error: None,
                     dropped_wave_share,
                     teaches: job.trustworthy && !motion_sigma.is_empty() && !mismatch,
+                    tuning,
                     motion_sigma,
                     model_error: job.model_error,
                     start_var: job.start_var,
@@ -233,6 +256,7 @@ impl Computer {
                 start_var: job.start_var,
                 check_var: job.check_var,
                 teaches: false,
+                tuning,
             },
         }
     }
@@ -298,6 +322,17 @@ impl Computer {
                 &opts,
             )
         })
+    }
+}
+
+impl Computer {
+    /// One step of the in-situ roll tuning (a round's next candidate), run between jobs so that it
+    /// does not delay a forecast; a finished round's tuning becomes the model forecasts run with.
+    pub fn tune(&mut self) {
+        if let Some(model) = self.tuning.work(&self.base) {
+            self.table = response_table(&model);
+            self.model = model;
+        }
     }
 }
 

@@ -18,7 +18,7 @@ pub const WAVES_SCHEMA_VERSION: u32 = 2;
 pub const FORECAST_SCHEMA_VERSION: u32 = 3;
 /// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
 /// estimator's refusals, restarts and bias).
-pub const STATUS_SCHEMA_VERSION: u32 = 4;
+pub const STATUS_SCHEMA_VERSION: u32 = 5;
 /// Vessels a forecast or status can describe.
 pub const MAX_VESSELS: usize = 4;
 /// The most components a wave field may carry: the wavenumber bins of a 256 x 256 radar grid. A field
@@ -217,7 +217,7 @@ pub struct ForecastHeader {
     pub series_trusted_from_s: [f64; 6 * MAX_VESSELS],
 }
 
-/// Health of the daemon, published every cycle. 384 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
+/// Health of the daemon, published every cycle. 488 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 pub struct Status {
@@ -275,6 +275,13 @@ pub struct Status {
     pub link_loss: f64,
     /// Age of the newest message from the other ship, s (-1: none yet).
     pub link_age_s: f64,
+    /// Each vessel's in-situ roll tuning in force ([`crate::tuning`]): the added linear roll damping
+    /// and the quadratic one (fractions of critical, the quadratic's at a 3 deg roll) and the
+    /// correction of the roll natural frequency (a fraction); zeros: the model as built.
+    pub roll_tuning: [[f64; 3]; MAX_VESSELS],
+    /// 1 once the roll tuning has converged (its last rounds moved no parameter), else 0.
+    pub roll_tuning_converged: u32,
+    pub reserved: u32,
 }
 
 /// The link's state (`link_state` of [`Status`]).
@@ -328,7 +335,7 @@ impl ForecastHeader {
 
 impl Status {
     /// The payload's stable type name on the wire (its layout's version: a new field is a new name).
-    pub const TYPE_NAME: &'static str = "shipcast_Status_v4";
+    pub const TYPE_NAME: &'static str = "shipcast_Status_v5";
 }
 
 impl LinkStatus {
@@ -576,7 +583,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 512);
-        assert_eq!(std::mem::size_of::<Status>(), 384);
+        assert_eq!(std::mem::size_of::<Status>(), 488);
         assert_eq!(std::mem::size_of::<LinkStatus>(), 64);
     }
 }

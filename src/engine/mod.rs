@@ -18,6 +18,7 @@ mod job;
 mod publish;
 mod setup;
 mod tick;
+mod tune;
 
 pub use job::{Computer, Done, Job};
 pub use setup::{
@@ -185,6 +186,12 @@ pub struct Engine {
     job_offset: Vec<[f64; 6]>,
     /// Per vessel, whether the running job started it from rest for want of fresh motion.
     job_unknown: Vec<bool>,
+    /// The measured trace the in-situ roll tuning scores its cases against (time, every series).
+    trace: std::collections::VecDeque<(f64, Vec<f64>)>,
+    /// Per vessel, the roll tuning in force (damping, quadratic, frequency; [`crate::tuning`]), and
+    /// whether it converged.
+    roll_tuning: [[f64; 3]; MAX_VESSELS],
+    roll_tuning_converged: bool,
 }
 
 impl Engine {
@@ -252,6 +259,9 @@ impl Engine {
             heel_time_s: None,
             job_offset: vec![[0.0; 6]; n_bodies],
             job_unknown: vec![false; n_bodies],
+            trace: std::collections::VecDeque::new(),
+            roll_tuning: [[0.0; 3]; MAX_VESSELS],
+            roll_tuning_converged: false,
             bias_time_s: cfg.estimator.bias_time_s,
             drift_time_s: cfg.estimator.drift_time_s,
             angle_bias_rad: cfg.estimator.angle_bias_rad,

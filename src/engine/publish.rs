@@ -8,6 +8,9 @@ impl Engine {
     pub fn done(&mut self, d: Done) -> Option<Output> {
         self.busy = false;
         self.last_compute_ms = d.compute_ms;
+        if let Some(r) = &d.tuning {
+            self.tuned(r);
+        }
         match (d.values, d.error) {
             (Some(values), _) => {
                 let mut header = d.header;
@@ -166,6 +169,8 @@ impl Engine {
             dropped_implausible: c.implausible,
             motion_restarts: c.motion_restarts,
             running: running as u32,
+            roll_tuning: self.roll_tuning,
+            roll_tuning_converged: self.roll_tuning_converged as u32,
             ..Status::default()
         };
         (s.link_state, s.link_latency_ms, s.link_loss, s.link_age_s) = match self.link {

@@ -88,6 +88,7 @@ impl Engine {
                     start_offset: start.start_offset,
                     check_var: start.check_var,
                     track: pose.track,
+                    tune: self.tune_input(t0, trustworthy && motion_fresh.iter().all(|f| *f), fl),
                     header,
                 });
             }
@@ -132,8 +133,11 @@ impl Engine {
             fl |= flags::WAVES_FROZEN;
         }
         // ages are never negative: a field stamped a little after the newest motion (within the
-        // clocks' skew) is taken as current
-        match self.field.as_ref().map(|f| (t0 - f.time_s).max(0.0)) {
+        // clocks' skew) is taken as current. With no vessel's motion fresh, the waves' age is taken
+        // against the newest motion there is (as the status's is): stale motion is not stale waves
+        // (with no motion at all it reads 0, and `no_motion` says why nothing is forecast)
+        let wave_ref_s = if t0.is_finite() { t0 } else { self.newest_motion_s().1 };
+        match self.field.as_ref().map(|f| (wave_ref_s - f.time_s).max(0.0)) {
             None => fl |= flags::NO_WAVES,
             Some(a) if a.is_nan() || a > cfg.suppress_wave_age_s => fl |= flags::NO_WAVES | flags::STALE_WAVES,
             Some(a) if a > cfg.max_wave_age_s => fl |= flags::STALE_WAVES,
@@ -267,29 +271,25 @@ impl Engine {
     /// roll or pitch keeps a heel (gravity-referenced: part of what the forecast leaves out of it as
     /// bias may be heel, and a forecast settles to the model's equilibrium whatever its start).
     fn learn_model_error(&mut self, t0: f64) {
-        let (n_bodies, dt, max_gap_s) = (self.n_bodies, self.dt_s, self.cfg.max_gap_s);
-        let hist = &self.hist;
-        let model_mean = &self.model_mean;
-        let angle_bias_rad = self.angle_bias_rad;
+        let (dt, max_gap_s) = (self.dt_s, self.cfg.max_gap_s);
+        let (hist, model_mean, angle_bias_rad) = (&self.hist, &self.model_mean, self.angle_bias_rad);
         self.model_error.observe(t0, |t| {
-            let mut x = vec![0.0; 6 * n_bodies];
-            for (b, h) in hist.iter().enumerate() {
-                let r = h.resample(t, dt, 0, max_gap_s)?;
-                let bias = h.bias();
-                for d in 0..6 {
-                    let mean = model_mean[b].value[d];
-                    let heel = MEASURED_MEAN_DOFS.contains(&d) && beyond(bias[d] - mean, angle_bias_rad) != 0.0;
-                    x[6 * b + d] = r.x0[d]
-                        + match (bias[d] != 0.0, heel) {
-                            (false, _) => 0.0,
-                            (true, true) => bias[d],
-                            (true, false) => mean,
-                        };
-                }
-            }
-            Some(x)
+            measured_series(hist, model_mean, angle_bias_rad, t, dt, max_gap_s)
         });
         self.log_model_error();
+    }
+
+    /// Every series' measured value at `t` as past forecasts are checked against it
+    /// ([`Self::learn_model_error`]); None where a vessel's history does not reach.
+    pub(super) fn measured_at(&self, t: f64) -> Option<Vec<f64>> {
+        measured_series(
+            &self.hist,
+            &self.model_mean,
+            self.angle_bias_rad,
+            t,
+            self.dt_s,
+            self.cfg.max_gap_s,
+        )
     }
 
     /// The learnt model error in the log: when first learnt, then every 600 checks at 30 s.
@@ -410,4 +410,32 @@ impl Engine {
             .collect();
         (waves, known_leads, trustworthy)
     }
+}
+
+/// Every series' measured value at `t`, with the sensor's bias off as a forecast takes it (see
+/// [`Engine::learn_model_error`]).
+fn measured_series(
+    hist: &[Estimator],
+    model_mean: &[estimator::RunningMean],
+    angle_bias_rad: f64,
+    t: f64,
+    dt: f64,
+    max_gap_s: f64,
+) -> Option<Vec<f64>> {
+    let mut x = vec![0.0; 6 * hist.len()];
+    for (b, h) in hist.iter().enumerate() {
+        let r = h.resample(t, dt, 0, max_gap_s)?;
+        let bias = h.bias();
+        for d in 0..6 {
+            let mean = model_mean[b].value[d];
+            let heel = MEASURED_MEAN_DOFS.contains(&d) && beyond(bias[d] - mean, angle_bias_rad) != 0.0;
+            x[6 * b + d] = r.x0[d]
+                + match (bias[d] != 0.0, heel) {
+                    (false, _) => 0.0,
+                    (true, true) => bias[d],
+                    (true, false) => mean,
+                };
+        }
+    }
+    Some(x)
 }

@@ -307,7 +307,6 @@ impl Forecaster {
     /// Runs one forecast. Errors: inputs that do not fit the model; a state that diverges (which DOF,
     /// when): never NaN to the caller.
     pub fn forecast(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<&Forecast> {
-        let n = model.n();
         let dt = model.opts.dt_s;
         let length_s = req.length_s;
         if !(length_s.is_finite() && length_s > 0.0 && length_s <= MAX_FORECAST_LENGTH_S) {
@@ -322,6 +321,31 @@ impl Forecaster {
             )));
         }
         self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
+        self.run(model, req, steps)
+    }
+
+    /// [`Self::forecast`] with the wave force given (`force_for` of the same request on a model with
+    /// the same excitation): a model re-run from one start with other damping or stiffness (in-situ
+    /// tuning) need not sum the waves again.
+    pub fn forecast_forced(&mut self, model: &TimeModel, req: &ForecastRequest, force: &[f64]) -> Result<&Forecast> {
+        let n = model.n();
+        let steps = (req.length_s / model.opts.dt_s).round() as usize;
+        if force.len() != (steps + 1) * n {
+            return Err(Error::Input(format!(
+                "a given wave force of {} values for {} steps of {n} states",
+                force.len(),
+                steps + 1
+            )));
+        }
+        self.force.clear();
+        self.force.extend_from_slice(force);
+        self.run(model, req, steps)
+    }
+
+    /// The forecast over `steps` from the request's start with the wave force in `self.force`.
+    fn run(&mut self, model: &TimeModel, req: &ForecastRequest, steps: usize) -> Result<&Forecast> {
+        let n = model.n();
+        let dt = model.opts.dt_s;
         // the known radiation part: the convolution's only (the modal states carry their own past)
         self.known.clear();
         if matches!(model.kernel, Kernel::Convolution { .. }) {

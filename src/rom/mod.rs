@@ -28,6 +28,7 @@
 //! over the horizon, is evaluated by a non-uniform FFT when the field has many components
 //! ([`sinusoids`]).
 
+pub mod adjust;
 mod build;
 pub mod dense;
 pub mod drift;

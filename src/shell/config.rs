@@ -5,8 +5,9 @@
 pub use crate::settings::*;
 use std::path::Path;
 
-/// `SHIPCAST_FAULT=compute-panic` makes the daemon's compute thread panic on its first job: fault
-/// injection for the test of the daemon's liveness (a panic there ends the daemon with an error).
+/// Fault injection for the tests of the daemon's liveness: `SHIPCAST_FAULT=compute-panic` makes the
+/// daemon's compute thread panic on its first job (the daemon ends with an error),
+/// `SHIPCAST_FAULT=compute-hang` makes it never finish its first job (the watchdog stops being fed).
 pub const FAULT_ENV: &str = "SHIPCAST_FAULT";
 
 /// The environment variables that overlay the file: `SHIPCAST_<SECTION>__<KEY>` (e.g.

@@ -37,20 +37,29 @@ fn compute_thread(
     mut computer: Computer,
     jobs: std::sync::mpsc::Receiver<Job>,
     done: tokio::sync::mpsc::Sender<Done>,
-    inject_panic: bool,
+    fault: Option<String>,
 ) -> std::thread::JoinHandle<()> {
     std::thread::Builder::new()
         .name("shipcast-compute".into())
         .spawn(move || {
             while let Ok(job) = jobs.recv() {
-                if inject_panic {
-                    panic!("{FAULT_ENV}=compute-panic: the compute thread panics on its first job");
+                match fault.as_deref() {
+                    Some("compute-panic") => {
+                        panic!("{FAULT_ENV}=compute-panic: the compute thread panics on its first job")
+                    }
+                    Some("compute-hang") => loop {
+                        // a computation that never ends
+                        std::thread::park();
+                    },
+                    _ => {}
                 }
                 let t = Instant::now();
                 let msg = computer.run(job, || t.elapsed().as_secs_f64() * 1e3);
                 if done.blocking_send(msg).is_err() {
                     break;
                 }
+                // the in-situ tuning's work, once the forecast is on its way
+                computer.tune();
             }
         })
         .expect("spawning the compute thread")
@@ -161,8 +170,7 @@ impl Threads {
         }
         let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
         let (done_tx, done_rx) = tokio::sync::mpsc::channel::<Done>(4);
-        let inject_panic = std::env::var(FAULT_ENV).is_ok_and(|v| v == "compute-panic");
-        let compute = compute_thread(computer, job_rx, done_tx, inject_panic);
+        let compute = compute_thread(computer, job_rx, done_tx, std::env::var(FAULT_ENV).ok());
         Ok(Threads {
             in_rx,
             out_tx,
@@ -222,6 +230,11 @@ pub async fn run(
     // decision); a write error is logged and ends the recording, never the daemon
     let mut recorder = open_recorder(&cfg, &sys);
     let mut failure: Option<&str> = None;
+    // the watchdog is fed while the compute thread keeps up: a job outstanding for longer than
+    // `hung_after_s` is a hung computation, and systemd restarts the service
+    let hung_after_s = hung_after_s(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6));
+    let mut outstanding: Option<Instant> = None;
+    let mut hung = false;
     tokio::pin!(shutdown);
     loop {
         tokio::select! {
@@ -238,6 +251,11 @@ pub async fn run(
                     failure = Some("the compute thread ended unexpectedly");
                     break;
                 };
+                outstanding = None;
+                if hung {
+                    tracing::warn!("the compute thread finished its forecast at last: the watchdog is fed again");
+                    hung = false;
+                }
                 if let Some(out) = engine.done(d) {
                     if let Output::Forecast(h, v) = &out {
                         let rec = crate::shell::record::Record::Forecast(crate::shell::record::ForecastRecord::of(h, v));
@@ -252,13 +270,23 @@ pub async fn run(
                     failure = Some("the compute thread ended unexpectedly");
                     break;
                 }
-                if watchdog {
+                let busy_s = outstanding.map_or(0.0, |o| o.elapsed().as_secs_f64());
+                if busy_s > hung_after_s && !hung {
+                    hung = true;
+                    tracing::error!(
+                        busy_s,
+                        "the compute thread has been on one forecast for more than {hung_after_s} s (hung): {}",
+                        if watchdog { "the watchdog is no longer fed, so that systemd restarts shipcast" } else { "no watchdog is set (systemd's WatchdogSec) to restart shipcast" }
+                    );
+                }
+                if watchdog && !hung {
                     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
                 }
                 let t = clock();
                 record(&mut recorder, t, crate::shell::record::Record::Tick(crate::shell::record::TickRecord { clock_s: t }));
                 if let Some(job) = engine.tick(t) {
                     let _ = th.job_tx.send(job);
+                    outstanding = Some(Instant::now());
                 }
                 let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), true)));
             }
@@ -266,15 +294,26 @@ pub async fn run(
     }
     stop.store(true, Ordering::Relaxed);
     let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), false)));
-    finish(th, recorder, &engine);
+    finish(th, recorder, &engine, hung);
     match failure {
         Some(why) => Err(why.to_string().into()),
         None => Ok(()),
     }
 }
 
-/// A clean shutdown after the last status: the recording closed, systemd told, the threads joined.
-fn finish(th: Threads, recorder: Option<crate::shell::record::RotatingRecorder>, engine: &Engine) {
+/// The compute thread is hung when a job has been outstanding this long, s: with a watchdog, its
+/// interval less two periods (the last ping before it then lands inside the interval, and systemd acts
+/// one interval later), at least half of it; without, 30 s (said, nothing else acts on it).
+fn hung_after_s(period_s: f64, watchdog_s: Option<f64>) -> f64 {
+    match watchdog_s {
+        Some(w) => (w - 2.0 * period_s).max(w / 2.0),
+        None => 30.0,
+    }
+}
+
+/// A clean shutdown after the last status: the recording closed, systemd told, the threads joined (a
+/// hung compute thread is left to the process's end).
+fn finish(th: Threads, recorder: Option<crate::shell::record::RotatingRecorder>, engine: &Engine, hung: bool) {
     drop(th.out_tx);
     drop(th.job_tx);
     drop(th.in_rx);
@@ -286,7 +325,9 @@ fn finish(th: Threads, recorder: Option<crate::shell::record::RotatingRecorder>,
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Stopping]);
     let _ = th.output.join();
     let _ = th.input.join();
-    let _ = th.compute.join();
+    if !hung {
+        let _ = th.compute.join();
+    }
     let c = &engine.counters;
     tracing::info!(
         forecasts = c.forecasts,

@@ -42,6 +42,7 @@ pub fn drive(
             if let Some(o @ Output::Forecast(..)) = engine.done(d) {
                 on_output(o);
             }
+            computer.tune();
         }
         on_output(Output::Status(engine.status(at, at, true)));
     };
