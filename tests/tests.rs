@@ -7,6 +7,7 @@ mod util;
 mod bad_input;
 mod capytaine_barge;
 mod capytaine_barge_speeds;
+mod capytaine_close_pair;
 mod capytaine_demo;
 mod capytaine_messy_pair;
 mod capytaine_offset_box;

@@ -18,7 +18,7 @@ pub const TRACE_KEEP_S: f64 = 300.0;
 pub const APPLY_EVERY_S: f64 = 30.0;
 /// The tuning scores at most one candidate per this many seconds of the data clock (a candidate is a
 /// re-run of every case of its round: about a tenth of a core's second on the two-ship demo), s.
-pub const WORK_EVERY_S: f64 = 2.0;
+pub const WORK_EVERY_S: f64 = 3.0;
 /// Flags that keep a tick's start out of the cases (its history is not what the vessel did).
 const NOT_A_CASE: u32 = flags::HISTORY_SHORT | flags::HISTORY_GAP | flags::MOTION_RESTARTED;
 

@@ -158,6 +158,9 @@ pub struct IrfOptions {
     pub tail: TailChoice,
     /// What an indefinite B(w) becomes.
     pub passivity: Passivity,
+    /// Whether the system file said `passivity` (else the choice is made by the floors,
+    /// [`crate::rom::passivity::choose`]).
+    pub passivity_given: bool,
 }
 
 impl Default for IrfOptions {
@@ -167,6 +170,7 @@ impl Default for IrfOptions {
             duration_s: None,
             tail: TailChoice::Fitted,
             passivity: Passivity::Project,
+            passivity_given: false,
         }
     }
 }
@@ -369,6 +373,7 @@ fn irf_options(f: Option<&IrfFile>) -> std::result::Result<IrfOptions, (&'static
         }
         if let Some(p) = f.passivity {
             irf.passivity = p;
+            irf.passivity_given = true;
         }
         if let Some(t) = f.tail {
             irf.tail = t;

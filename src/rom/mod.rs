@@ -36,6 +36,7 @@ pub mod floor;
 pub mod forecast;
 pub mod model;
 pub mod outputs;
+pub mod passivity;
 pub mod regular;
 pub mod sinusoids;
 pub mod step;

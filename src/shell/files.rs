@@ -33,6 +33,9 @@ pub struct Loaded {
     pub files: Vec<PathBuf>,
     /// Observations on optional files (e.g. `.3fk + .3sc` against `.3`).
     pub notes: Vec<String>,
+    /// The choice of `irf.passivity` by the floors, where the file left it unsaid and the damping is
+    /// indefinite ([`crate::rom::passivity`]; already applied to `system`).
+    pub passivity: Option<crate::rom::passivity::PassivityChoice>,
 }
 
 /// Loads `system.toml` and the WAMIT files it names (`.1`, `.3` or else `.2`, `.hst`; `.3fk` and
@@ -103,7 +106,37 @@ pub fn load_system(path: &Path) -> Result<Loaded, Error> {
         system.add_speed_database(u, rad, exc, hst, &stem.display().to_string())?;
         files.extend([p1, p3, phst]);
     }
-    Ok(Loaded { system, files, notes })
+    let passivity = crate::rom::passivity::choose(&system);
+    if let Some(c) = &passivity {
+        system.spec.irf.passivity = c.taken;
+        tracing::info!(
+            "{}: its damping is indefinite at some frequencies; irf.passivity = \"{}\", the lowest in-band floor ({})",
+            path.display(),
+            crate::rom::passivity::name(c.taken),
+            describe_floors(c)
+        );
+    }
+    Ok(Loaded {
+        system,
+        files,
+        notes,
+        passivity,
+    })
+}
+
+/// Each passivity choice's floor, for the log and `db check`.
+pub fn describe_floors(c: &crate::rom::passivity::PassivityChoice) -> String {
+    c.floors
+        .iter()
+        .map(|(p, f)| {
+            let n = crate::rom::passivity::name(*p);
+            match f {
+                Ok(f) => format!("{n}: {:.2} %", 100.0 * f),
+                Err(e) => format!("{n}: none ({e})"),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// Reads a CSV or text file whole (for the CLI's own inputs).

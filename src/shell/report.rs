@@ -489,7 +489,16 @@ impl DbCheck<'_> {
                 },
                 100.0 * repair.largest,
                 w[repair.at]
-            )
+            )?;
+            match &self.loaded.passivity {
+                Some(c) => writeln!(
+                    out,
+                    "  chosen by the in-band floor of each choice (convolution models): {}; taken: \"{}\" (the lowest; `irf.passivity` in the system file overrides)",
+                    crate::shell::files::describe_floors(c),
+                    crate::rom::passivity::name(c.taken)
+                ),
+                None => writeln!(out, "  irf.passivity as the system file says"),
+            }
         }
     }
 
