@@ -39,7 +39,7 @@ const LM_DAMPING: f64 = 0.1;
 /// The tuning in force is the rounds' parameters averaged over about this many rounds (exponentially;
 /// half a minute at the daemon's pace). A round's answer follows its two minutes of sea, and that
 /// tracks the next minutes' best better than a longer average does (two-ship demo, roll correlation
-/// at 30 s: 0.885 / 0.865 over 15 rounds, 0.890 / 0.874 over one; docs/tuning.md).
+/// at 30 s: 0.885 / 0.865 over 15 rounds, 0.889 / 0.873 over two; docs/tuning.md).
 const SMOOTHING_ROUNDS: f64 = 2.0;
 /// Rounds in a row that moved no parameter of the tuning in force by more than [`CONVERGED_SHARE`] of
 /// its width: converged.
