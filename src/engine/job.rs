@@ -69,8 +69,8 @@ pub struct Computer {
     model: TimeModel,
     /// The model as built (at its speed), before the tuning.
     base: TimeModel,
-    /// The in-situ roll tuning (None: off, or no vessel's roll can be tuned) and its work between
-    /// jobs ([`Computer::tune`]).
+    /// The in-situ roll tuning (idle when off, or when no vessel's roll can be tuned) and its work
+    /// between jobs ([`Computer::tune`]).
     tuning: super::tune::Tuning,
     /// The model's response for the band (None: it could not be made; nothing is trusted then).
     table: Option<ResponseTable>,

@@ -249,12 +249,6 @@ impl Tuner {
     fn finish(&mut self, round: Round) -> TunerReport {
         let r0 = &round.residuals[0];
         let nf = round.free.len();
-        if nf == 0 {
-            // no vessel's roll excited enough: nothing moves
-            let mut report = self.report(None);
-            report.cases = round.cases.len();
-            return report;
-        }
         let widths: Vec<f64> = round
             .free
             .iter()
