@@ -747,3 +747,136 @@ fn a_motion_stall_does_not_call_fresh_waves_stale() {
         }
     }
 }
+
+/// A trusted forecast's initial heave may be this far from the truth, m: ten times the IMU's noise
+/// (0.01 m), far below the faults below (2 m, 50 m).
+const TRUSTED_START_TOL_M: f64 = 0.1;
+
+/// Forecasts of `run` issued after `from_s` (s after the log's start) that trust vessel 0 while its
+/// initial heave is more than [`TRUSTED_START_TOL_M`] from the truth, described.
+fn trusted_off_the_truth(run: &Run, records: &[(f64, Record)], from_s: f64) -> Vec<String> {
+    let t0 = start(records);
+    run.forecasts
+        .iter()
+        .filter(|(h, _)| h.issue_time_s - t0 > from_s && h.horizon_s[0] > 0.0)
+        .filter_map(|(h, v)| {
+            let (got, truth) = (initial(h, v, 2), truth_at(records, h.motion_time_s, 2));
+            ((got - truth).abs() > TRUSTED_START_TOL_M).then(|| {
+                format!(
+                    "at {:.1} s: heave {got:.3} m (true {truth:.3} m), trusted to {:.1} s, {:?}",
+                    h.issue_time_s - t0,
+                    h.horizon_s[0],
+                    flags::names(h.flags)
+                )
+            })
+        })
+        .collect()
+}
+
+/// The band (standard deviation) of vessel 0's heave at `lead_s` in a forecast, m.
+fn heave_sigma_at(h: &ForecastHeader, v: &[f64], lead_s: f64) -> f64 {
+    let per = h.steps as usize + 1;
+    let n = per * h.n_series as usize;
+    v[n + 2 * per + (lead_s / h.dt_s).round() as usize]
+}
+
+/// The largest ratio of the heave band at 30 s in `run`'s forecasts issued after `from_s` to the
+/// clean run's issued at the same time: what the faults taught the model error (forecasts from an
+/// estimate still settling after a restart hold the jump in their band, and are left out).
+fn heave_band_growth(run: &Run, t0: f64, from_s: f64) -> f64 {
+    let base: std::collections::HashMap<i64, f64> = baseline()
+        .forecasts
+        .iter()
+        .map(|(h, v)| ((h.issue_time_s * 1e3).round() as i64, heave_sigma_at(h, v, 30.0)))
+        .collect();
+    run.forecasts
+        .iter()
+        .filter(|(h, _)| h.issue_time_s - t0 > from_s && h.flags & flags::MOTION_SETTLING == 0)
+        .filter_map(|(h, v)| {
+            let b = base.get(&((h.issue_time_s * 1e3).round() as i64))?;
+            Some(heave_sigma_at(h, v, 30.0) / b)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How far the band at 30 s may grow over the clean run's after a fault the daemon refused: the
+/// checks it missed while refusing and their noise, not the fault's size.
+const BAND_GROWTH_AFTER_FAULT: f64 = 1.25;
+
+/// Was: five +50 m heave spikes in 0.5 s, the fifth just before a forecast, restarted the estimate
+/// from them: that forecast was published starting at 50 m with only `history_short`, the next good
+/// samples restarted it again, and the model error learnt from both (the band at 30 s grew many
+/// times for the rest of the run). A burst that the motion then leaves is taken back; while an
+/// estimate is restarted its vessel is trusted nowhere and nothing is learnt from it.
+#[test]
+fn a_burst_of_spikes_is_never_published_trusted_nor_learnt_from() {
+    const SPIKES: usize = 5;
+    const SPIKE_M: f64 = 50.0;
+    let t0 = start(&log().records);
+    let (h, _) = baseline()
+        .forecasts
+        .iter()
+        .find(|(h, _)| h.issue_time_s - t0 > FAULT_AT_S)
+        .expect("a forecast after the fault time");
+    let mut records = log().records.clone();
+    let burst: Vec<usize> = records
+        .iter()
+        .enumerate()
+        .filter(|(_, (_, r))| matches!(r, Record::Motion(m) if m.vessel == 0 && m.time_s <= h.motion_time_s))
+        .map(|(i, _)| i)
+        .collect();
+    for &i in &burst[burst.len() - SPIKES..] {
+        if let Record::Motion(m) = &mut records[i].1 {
+            m.x[2] += SPIKE_M;
+        }
+    }
+    let run = drive(&records);
+    invariants(&run);
+    forecasts_go_on(&records, &run, "the burst");
+    let wrong = trusted_off_the_truth(&run, &records, FAULT_AT_S - 1.0);
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    let growth = heave_band_growth(&run, t0, FAULT_AT_S);
+    assert!(
+        growth < BAND_GROWTH_AFTER_FAULT,
+        "the heave band at 30 s grew {growth:.2} times"
+    );
+    // the burst is gone as soon as the motion leaves it: forecasts are trusted again within seconds
+    let back = after(&run, t0, FAULT_AT_S + 10.0);
+    assert!(
+        back.iter().all(|h| h.horizon_s[0] > 0.0),
+        "not trusted again after the burst"
+    );
+}
+
+/// Was: a heave sensor re-zeroed by +2 m restarted the estimate and its forecasts were trusted at
+/// once, starting 2 m off with the band of the sensor's drift (0.06 m), until the new offset had
+/// been averaged. Now a restarted estimate is trusted nowhere until its offset is known again, and
+/// then its forecasts start from the motion.
+#[test]
+fn a_sensor_re_zeroed_is_not_trusted_until_its_new_offset_is_known() {
+    const OFFSET_M: f64 = 2.0;
+    let mut records = log().records.clone();
+    let t0 = start(&records);
+    for (_, r) in records.iter_mut() {
+        if let Record::Motion(m) = r
+            && m.vessel == 0
+            && m.time_s - t0 > FAULT_AT_S
+        {
+            m.x[2] += OFFSET_M;
+        }
+    }
+    let run = drive(&records);
+    invariants(&run);
+    forecasts_go_on(&records, &run, "the offset");
+    let wrong = trusted_off_the_truth(&run, &records, FAULT_AT_S - 1.0);
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    let growth = heave_band_growth(&run, t0, FAULT_AT_S);
+    assert!(
+        growth < BAND_GROWTH_AFTER_FAULT,
+        "the heave band at 30 s grew {growth:.2} times"
+    );
+    assert!(
+        run.statuses.iter().any(|s| s.flags & flags::MOTION_SETTLING != 0),
+        "the status says the estimate is settling"
+    );
+}

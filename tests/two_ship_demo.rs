@@ -427,3 +427,121 @@ fn a_vessel_whose_motion_stops_is_forecast_from_rest_and_trusted_nowhere() {
     eprintln!("the lighter's roll inside its 90 % band at leads 0-60 s during the outage: {c:.2} of {n}");
     assert!(n > 100 && c >= UNKNOWN_START_COVERAGE, "{c} of {n}");
 }
+
+/// Where in [`sea_log`] the spike burst is put, s after its start (the model error checked by then).
+const BURST_AT_S: f64 = 200.0;
+/// No trusted forecast of the lighter rolls beyond this, rad (30 deg: far beyond the demo's sea,
+/// whose roll stays under 5 deg).
+const LIGHTER_ROLL_MAX_RAD: f64 = 0.52;
+
+/// Was: five +50 m heave spikes of the carrier in 0.5 s, the fifth just before a forecast, restarted
+/// the carrier's estimate from them; the forecast started the carrier 50 m up, and the lighter moored
+/// to it, judged alone, was published trusted with a roll of 7.4 rad. Now a vessel whose estimate is
+/// restarted withdraws trust from every vessel coupled to it.
+#[test]
+fn a_partner_s_bad_start_withdraws_trust_from_the_hull_moored_to_it() {
+    let l = sea_log();
+    let start = l.records.first().map(|r| r.0).unwrap();
+    let burst_tick = sea_forecasts()
+        .iter()
+        .find(|f| f.header.issue_time_s - start > BURST_AT_S)
+        .expect("a forecast after the burst time")
+        .header;
+    let mut records = l.records.clone();
+    let burst: Vec<usize> = records
+        .iter()
+        .enumerate()
+        .filter(|(_, (_, r))| matches!(r, Record::Motion(m) if m.vessel == 0 && m.time_s <= burst_tick.motion_time_s))
+        .map(|(i, _)| i)
+        .collect();
+    for &i in &burst[burst.len() - 5..] {
+        if let Record::Motion(m) = &mut records[i].1 {
+            m.x[2] += 50.0;
+        }
+    }
+    let faulted = crate::util::SimLog {
+        cfg: l.cfg.clone(),
+        sys: l.sys.clone(),
+        records,
+    };
+    let fs = forecasts_of(&faulted, shipcast::rom::drift::DRIFT_WINDOW_S);
+    let at_burst = fs
+        .iter()
+        .find(|f| f.header.issue_time_s == burst_tick.issue_time_s)
+        .expect("the burst's forecast is published");
+    assert_eq!(
+        &at_burst.header.horizon_s[..2],
+        &[0.0, 0.0],
+        "the forecast from the burst trusts a vessel"
+    );
+    for f in &fs {
+        let h = &f.header;
+        if h.horizon_s[1] <= 0.0 {
+            continue;
+        }
+        let steps = (h.horizon_s[1] / h.dt_s).floor() as usize;
+        let roll = (0..=steps)
+            .map(|k| f.values[(6 + 3) * (h.steps as usize + 1) + k].abs())
+            .fold(0.0, f64::max);
+        assert!(
+            roll < LIGHTER_ROLL_MAX_RAD,
+            "the lighter trusted with a roll of {roll:.2} rad at {:.1} s",
+            h.issue_time_s - start
+        );
+    }
+}
+
+/// When the lighter's clock steps an hour ahead in [`sea_log`], s after its start.
+const PEER_CLOCK_AT_S: f64 = 200.0;
+
+/// Was: the other ship's motion stamped an hour ahead (its clock, over the link) raised
+/// `clocks_disagree` and stopped every forecast, the own hull's included. Now each vessel's clock is
+/// judged alone against the radar's: the lighter is forecast from rest and trusted nowhere, the
+/// carrier's forecasts go on.
+#[test]
+fn a_peer_an_hour_ahead_does_not_stop_the_own_hull_s_forecasts() {
+    use shipcast::shell::ipc::wire::flags;
+    let l = sea_log();
+    let start = l.records.first().map(|r| r.0).unwrap();
+    let mut records = l.records.clone();
+    for (t, r) in records.iter_mut() {
+        if let Record::Motion(m) = r
+            && m.vessel == 1
+            && *t - start >= PEER_CLOCK_AT_S
+        {
+            m.time_s += 3600.0;
+        }
+    }
+    let faulted = crate::util::SimLog {
+        cfg: l.cfg.clone(),
+        sys: l.sys.clone(),
+        records,
+    };
+    // from a minute after the step (the resync, the model error's checks) to the end of the log
+    let late = |fs: &[Forecast]| -> Vec<ForecastHeader> {
+        fs.iter()
+            .map(|f| f.header)
+            .filter(|h| h.issue_time_s - start > PEER_CLOCK_AT_S + 60.0)
+            .collect()
+    };
+    let (base, got) = (
+        late(sea_forecasts()),
+        late(&forecasts_of(&faulted, shipcast::rom::drift::DRIFT_WINDOW_S)),
+    );
+    assert!(
+        got.len() + 2 >= base.len(),
+        "{} forecasts with the lighter's clock an hour ahead, {} without",
+        got.len(),
+        base.len()
+    );
+    for h in &got {
+        assert!(h.flags & flags::MOTION_CLOCK_APART != 0, "{:?}", flags::names(h.flags));
+        assert_eq!(h.horizon_s[1], 0.0, "the lighter trusted on a clock an hour ahead");
+    }
+    let trusted = got.iter().filter(|h| h.horizon_s[0] > 0.0).count();
+    assert!(
+        trusted * 2 > got.len(),
+        "the carrier trusted in {trusted} of {} forecasts",
+        got.len()
+    );
+}

@@ -311,6 +311,14 @@ fn flag_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
             "Model not rebuilt for this speed (beyond its databases): not trusted",
         ),
         (
+            "motion_clock_apart",
+            "A vessel's clock disagrees with the radar's: it is not trusted",
+        ),
+        (
+            "motion_settling",
+            "Motion sensor re-zeroed: not trusted until its new offset is learnt",
+        ),
+        (
             "model_error_unchecked",
             "Learning the model's error: no lead trusted until forecasts are checked",
         ),

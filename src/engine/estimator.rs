@@ -25,7 +25,11 @@
 //!   (the stall's first two outputs are taken back). A refused sample never enters the filter, the
 //!   smoother or the radiation history.
 //! - A real jump (a sensor re-zeroed) is told from a spike by persistence: `reset_samples` refused
-//!   samples in a row that agree with each other restart the estimate from them.
+//!   samples in a row that agree with each other restart the estimate from them. The estimate before
+//!   is kept for [`REVERT_WINDOW_S`]: a sample the new one refuses but the old one takes shows the
+//!   run was a burst of spikes, and the old estimate comes back without it. A restarted estimate is
+//!   settling ([`Estimator::settling`]) until its new offset is averaged (a fifth of `bias_time_s`):
+//!   its start may be off by the jump, which its start's variance holds.
 //! - Sensor bias: the displacement of a DOF with hydrostatic restoring (heave, roll, pitch) has zero
 //!   mean about the equilibrium in linear waves, so its long average (time constant `bias_time_s`,
 //!   each sample counting for the time since the one before, at most `BIAS_MAX_INTERVAL_S`) is
@@ -41,6 +45,10 @@ use std::collections::VecDeque;
 
 /// The filter passes motion up to this many times the database's highest frequency.
 pub const BANDWIDTH_FACTOR: f64 = 4.0;
+
+/// A restarted estimate's predecessor is kept this long after the restart, s: a sample that the new
+/// estimate refuses and the old takes within it takes the restart back (a burst of spikes).
+pub const REVERT_WINDOW_S: f64 = 2.0;
 
 /// Samples closer than this to the newest taken are refused as duplicates: the kept window holds at
 /// most 1000 samples a second, whatever a sensor sends.
@@ -177,6 +185,9 @@ pub enum Refusal {
         value: f64,
         bound: f64,
     },
+    /// Nearer a run of refused samples than the estimate (which the gate's growth over the run would
+    /// let take it): the run goes on, until `reset_samples` restart the estimate from it.
+    InRun,
     /// A change since the last estimate no allowed acceleration makes: the DOF, what, the change and
     /// the largest allowed.
     Jump {
@@ -193,6 +204,9 @@ pub enum Taken {
     Accepted,
     /// The estimate restarted from a run of refused samples that agree (a real jump).
     Restarted,
+    /// A restart taken back: the sample agrees with the estimate before it, and the run it restarted
+    /// from (a burst of spikes) is dropped.
+    Reverted,
 }
 
 /// One DOF's Gaussian: mean (displacement, velocity) and covariance (pp, pv, vv).
@@ -414,6 +428,28 @@ pub struct Estimator {
     /// A taken sample has differed from the one before it (kept across a restart: the sensor has
     /// been seen moving).
     moved: bool,
+    /// The last restart from a jump while its new offset is not yet averaged
+    /// ([`Estimator::settling`]).
+    jump: Option<Jump>,
+}
+
+/// A restart from a jump: when, how far the first sample of the run was from the old estimate's
+/// prediction per DOF, and (for [`REVERT_WINDOW_S`]) the estimate before it.
+#[derive(Debug, Clone)]
+struct Jump {
+    at_s: f64,
+    size: [f64; 6],
+    before: Option<Box<Learnt>>,
+}
+
+/// What an estimate has learnt from its samples: what a restart forgets and a revert restores.
+#[derive(Debug, Clone, Default)]
+struct Learnt {
+    entries: VecDeque<Entry>,
+    bias: RunningMean,
+    innovation: [RunningMean; 3],
+    checks: VecDeque<Check>,
+    next_check_s: Option<f64>,
 }
 
 impl Estimator {
@@ -432,6 +468,7 @@ impl Estimator {
             last_received: None,
             repeats: 0,
             moved: false,
+            jump: None,
         }
     }
 
@@ -441,6 +478,15 @@ impl Estimator {
         self.candidate.clear();
         self.checks.clear();
         self.next_check_s = None;
+        if let Some(j) = &mut self.jump {
+            j.before = None;
+        }
+    }
+
+    /// Whether the estimate restarted from a jump and its new offset is not yet averaged (a fifth of
+    /// `bias_time_s`): its start may be off by as much as the jump.
+    pub fn settling(&self) -> bool {
+        self.jump.is_some()
     }
 
     pub fn newest_time_s(&self) -> Option<f64> {
@@ -504,9 +550,10 @@ impl Estimator {
         let held = self.drift_in_bias_var();
         let prior_s = HINDSIGHT_PRIOR_BIAS_TIMES * self.spec.bias_time_s;
         let learned_s = self.learned.span_s.min(self.hindsight_memory_s());
+        let jump = self.jump.as_ref().map_or([0.0; 6], |j| j.size);
         Some(std::array::from_fn(|d| {
             let s2 = self.spec.drift[d] * self.spec.drift[d];
-            let prior = estimate[d] + (s2 - held[d]).max(0.0);
+            let prior = estimate[d] + (s2 - held[d]).max(0.0) + jump[d] * jump[d];
             if self.spec.learned[d] && self.bias_taken(d) && learned_s > 0.0 {
                 let learned = (prior_s * prior + learned_s * self.learned.value[d].max(0.0)) / (prior_s + learned_s);
                 learned.max(prior)
@@ -625,6 +672,19 @@ impl Estimator {
         }
     }
 
+    /// The largest change of DOF d's displacement and velocity from the prediction `pred` over `dt`
+    /// the gate allows: what the bound's acceleration makes, and `gate_sigma` standard deviations of
+    /// the prediction and the noise.
+    fn allowed(&self, pred: &Gauss, d: usize, dt: f64) -> (f64, f64) {
+        let s = &self.spec;
+        let (rx, rv) = (s.noise_x[d].powi(2), s.noise_v[d].powi(2));
+        let a = s.bounds.max_a[d];
+        (
+            0.5 * a * dt * dt + s.gate_sigma * (pred.p[0] + rx).sqrt(),
+            a * dt + s.gate_sigma * (pred.p[2] + rv).sqrt(),
+        )
+    }
+
     /// The sample filtered after `prev`, or why it cannot follow it.
     fn follow(&self, prev: &Entry, time_s: f64, x: [f64; 6], v: [f64; 6]) -> Result<Entry, Refusal> {
         let s = &self.spec;
@@ -640,9 +700,7 @@ impl Estimator {
             let pred = prev.filtered[d].predict(dt, s.q[d]);
             let (rx, rv) = (s.noise_x[d].powi(2), s.noise_v[d].powi(2));
             if s.method == Method::Kalman {
-                let a = s.bounds.max_a[d];
-                let allowed_x = 0.5 * a * dt * dt + s.gate_sigma * (pred.p[0] + rx).sqrt();
-                let allowed_v = a * dt + s.gate_sigma * (pred.p[2] + rv).sqrt();
+                let (allowed_x, allowed_v) = self.allowed(&pred, d, dt);
                 let (cx, cv) = ((x[d] - pred.m[0]).abs(), (v[d] - pred.m[1]).abs());
                 if cx > allowed_x {
                     return Err(Refusal::Jump {
@@ -723,13 +781,88 @@ impl Estimator {
         let entry = match self.entries.back() {
             None => self.first(time_s, x, v),
             Some(prev) => match self.follow(prev, time_s, x, v) {
+                // the estimate's gate widens with the time since the last sample it took: a sample
+                // closer to a run of refused samples than to the estimate continues the run (a jump
+                // smaller than the gate grown over the run is not taken for motion)
+                Ok(_) if self.continues_run(prev, time_s, x, v) => {
+                    return self.refused(Refusal::InRun, time_s, x, v);
+                }
                 Ok(e) => e,
-                Err(why) => return self.refused(why, time_s, x, v),
+                Err(why) => {
+                    if self.revert(time_s, x, v) {
+                        return Ok(Taken::Reverted);
+                    }
+                    return self.refused(why, time_s, x, v);
+                }
             },
         };
         self.candidate.clear();
         self.take(entry);
         Ok(Taken::Accepted)
+    }
+
+    /// Whether the sample, which the estimate at `prev` takes, is nearer the run of refused samples
+    /// (as a share of what each allows) and the run takes it too.
+    fn continues_run(&self, prev: &Entry, time_s: f64, x: [f64; 6], v: [f64; 6]) -> bool {
+        let Some(last) = self
+            .candidate
+            .last()
+            .filter(|c| time_s - c.time_s >= MIN_SAMPLE_INTERVAL_S)
+        else {
+            return false;
+        };
+        let run = self.reach(last, time_s, x, v);
+        run <= 1.0 && run < self.reach(prev, time_s, x, v)
+    }
+
+    /// The largest share of the change the gate allows from `prev` that the sample takes, over the
+    /// DOFs, displacement and velocity (above 1: refused).
+    fn reach(&self, prev: &Entry, time_s: f64, x: [f64; 6], v: [f64; 6]) -> f64 {
+        let s = &self.spec;
+        let dt = time_s - prev.time_s;
+        (0..6)
+            .map(|d| {
+                let pred = prev.filtered[d].predict(dt, s.q[d]);
+                let (allowed_x, allowed_v) = self.allowed(&pred, d, dt);
+                ((x[d] - pred.m[0]).abs() / allowed_x).max((v[d] - pred.m[1]).abs() / allowed_v)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Takes the last restart back if the sample, refused by the estimate since, agrees with the one
+    /// before it within [`REVERT_WINDOW_S`] of the restart: the run restarted from was a burst of
+    /// spikes. The sample is taken into the old estimate; the burst is dropped.
+    fn revert(&mut self, time_s: f64, x: [f64; 6], v: [f64; 6]) -> bool {
+        let Some(before) = self
+            .jump
+            .as_mut()
+            .filter(|j| time_s - j.at_s <= REVERT_WINDOW_S)
+            .and_then(|j| j.before.take())
+        else {
+            return false;
+        };
+        let followed = before
+            .entries
+            .back()
+            .filter(|prev| time_s - prev.time_s >= MIN_SAMPLE_INTERVAL_S)
+            .and_then(|prev| self.follow(prev, time_s, x, v).ok());
+        let Some(e) = followed else {
+            // not the old estimate's either: kept for the next sample
+            if let Some(j) = &mut self.jump {
+                j.before = Some(before);
+            }
+            return false;
+        };
+        let b = *before;
+        self.entries = b.entries;
+        self.bias = b.bias;
+        self.innovation = b.innovation;
+        self.checks = b.checks;
+        self.next_check_s = b.next_check_s;
+        self.candidate.clear();
+        self.jump = None;
+        self.take(e);
+        true
     }
 
     /// A sample refused by the gate: kept as a candidate jump; `reset_samples` in a row that agree
@@ -746,11 +879,26 @@ impl Estimator {
         if self.candidate.len() < self.spec.reset_samples.max(1) {
             return Err(why);
         }
-        self.entries.clear();
-        self.bias = RunningMean::default();
-        self.innovation = Default::default();
-        self.checks.clear();
-        self.next_check_s = None;
+        // how far the run's first sample is from the estimate it leaves, predicted to it
+        let first = &self.candidate[0];
+        let size = match self.entries.back() {
+            Some(prev) => std::array::from_fn(|d| {
+                (first.x[d] - prev.filtered[d].predict(first.time_s - prev.time_s, self.spec.q[d]).m[0]).abs()
+            }),
+            None => [0.0; 6],
+        };
+        let before = Learnt {
+            entries: std::mem::take(&mut self.entries),
+            bias: std::mem::take(&mut self.bias),
+            innovation: std::mem::take(&mut self.innovation),
+            checks: std::mem::take(&mut self.checks),
+            next_check_s: self.next_check_s.take(),
+        };
+        self.jump = Some(Jump {
+            at_s: time_s,
+            size,
+            before: (!before.entries.is_empty()).then(|| Box::new(before)),
+        });
         for e in std::mem::take(&mut self.candidate) {
             self.take(e);
         }
@@ -768,6 +916,15 @@ impl Estimator {
             None => 0.0,
         };
         self.bias.add(dt, &e.x, self.spec.bias_time_s);
+        if let Some(j) = &mut self.jump {
+            if e.time_s - j.at_s > REVERT_WINDOW_S {
+                j.before = None;
+            }
+            // settled: the new offset is averaged as a first start's bias is
+            if self.bias.span_s >= 0.2 * self.spec.bias_time_s {
+                self.jump = None;
+            }
+        }
         if self.entries.back().is_some() && dt > 0.0 {
             let n: [[f64; 2]; 6] =
                 std::array::from_fn(|d| [e.x[d] - e.predicted[d].m[0], e.v[d] - e.predicted[d].m[1]]);
@@ -1028,6 +1185,58 @@ mod tests {
             }
         }
         assert_eq!(e.len(), 5);
+    }
+
+    #[test]
+    fn a_restart_settles_until_its_offset_is_averaged_and_its_start_holds_the_jump() {
+        let mut e = fed(Method::Kalman, 50.0, |_| false);
+        let before = e.start_var(50.0).unwrap()[2];
+        let mut taken = vec![];
+        let mut t = 50.1;
+        while t < 50.0 + 0.25 * e.spec.bias_time_s {
+            let (mut x, v) = wave(t);
+            x[2] += 2.0;
+            taken.push(e.push(t, x, v));
+            if taken.last() == Some(&Ok(Taken::Restarted)) {
+                assert!(e.settling());
+                let var = e.start_var(t).unwrap()[2];
+                assert!(
+                    var > before + 3.0 && var < before + 5.0,
+                    "{before} then {var}: the jump's square is in it"
+                );
+            }
+            t += 0.1;
+        }
+        assert_eq!(
+            taken.iter().filter(|r| **r == Ok(Taken::Restarted)).count(),
+            1,
+            "{:?}",
+            &taken[..10]
+        );
+        assert!(!e.settling(), "settled once the new offset is averaged");
+        // the wave's own offset 0.2 and the sensor's 2
+        assert!((e.bias()[2] - 2.2).abs() < 0.05, "the new offset {}", e.bias()[2]);
+    }
+
+    #[test]
+    fn a_burst_of_spikes_the_motion_leaves_is_taken_back() {
+        let mut e = fed(Method::Kalman, 50.0, |_| false);
+        let n = e.len();
+        for k in 1..=5 {
+            let t = 50.0 + k as f64 * 0.1;
+            let (mut x, v) = wave(t);
+            x[2] += 50.0;
+            let got = e.push(t, x, v);
+            assert_eq!(got.is_ok(), k == 5, "{k}: {got:?}");
+        }
+        assert!(e.settling());
+        let (x, v) = wave(50.6);
+        assert_eq!(e.push(50.6, x, v), Ok(Taken::Reverted));
+        assert!(!e.settling());
+        assert_eq!(e.len(), n + 1, "the burst is gone, the old estimate goes on");
+        let r = e.resample(50.6, 0.1, 10, 2.0).unwrap();
+        let got = r.x0[2] + e.bias()[2];
+        assert!((got - wave(50.6).0[2]).abs() < 0.05, "{got}");
     }
 
     #[test]

@@ -40,13 +40,24 @@ impl Engine {
         match self.hist[b].push(m.time_s, m.x, m.v) {
             Ok(taken) => {
                 self.arrival[b] = Some(clock_s);
-                if taken == Taken::Restarted {
-                    c.motion_restarts += 1;
-                    self.state_flags |= flags::MOTION_RESTARTED;
-                    tracing::warn!(
-                        vessel = b,
-                        "motion samples that agree with each other but not with the estimate: a real jump, the estimate restarts from them"
-                    );
+                match taken {
+                    Taken::Restarted => {
+                        c.motion_restarts += 1;
+                        self.state_flags |= flags::MOTION_RESTARTED;
+                        tracing::warn!(
+                            vessel = b,
+                            "motion samples that agree with each other but not with the estimate: a real jump, the estimate restarts from them (trusted nowhere until its new offset is averaged)"
+                        );
+                    }
+                    Taken::Reverted => {
+                        c.implausible += 1;
+                        self.state_flags |= flags::MOTION_IMPLAUSIBLE;
+                        tracing::warn!(
+                            vessel = b,
+                            "the motion is back where it was before the last restart: the run it restarted from was a burst of spikes, dropped"
+                        );
+                    }
+                    Taken::Accepted => {}
                 }
             }
             Err(Refusal::NonFinite) => {
@@ -446,6 +457,7 @@ fn refusal_text(why: &Refusal) -> String {
     let name = |d: usize| crate::hydro::Dof::of_index(d).output_name();
     let show = |d: usize, v: f64| crate::hydro::Dof::of_index(d).to_output(v);
     match *why {
+        Refusal::InRun => "nearer a run of refused samples than the estimate (a jump, if they go on)".into(),
         Refusal::Bound {
             dof,
             what,

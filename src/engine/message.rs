@@ -94,6 +94,15 @@ pub mod flags {
     /// The model could not be rebuilt for the forward speed (a speed beyond the databases'): the
     /// forecast is the model's at the speed it was built for, and nothing is trusted.
     pub const MODEL_SPEED_MISMATCH: u32 = 524_288;
+    /// A vessel's motion estimate restarted from a jump (a sensor re-zeroed) and its new offset is not
+    /// yet averaged (`estimator.bias_time_s` / 5): its start may be off by the jump, so that vessel
+    /// and every vessel coupled to it are trusted nowhere, and nothing is learnt from the forecast.
+    pub const MOTION_SETTLING: u32 = 1_048_576;
+    /// A vessel's motion is stamped apart from the radar's clock (behind the newest field beyond the
+    /// clocks' skew, or ahead of it beyond `forecast.suppress_wave_age_s`) while another vessel's agrees:
+    /// that vessel alone is forecast from rest and trusted nowhere (the other ship's clock, over the
+    /// link); the others go on. With no vessel agreeing, `clocks_disagree`.
+    pub const MOTION_CLOCK_APART: u32 = 2_097_152;
 
     /// Names of the set bits.
     pub fn names(f: u32) -> Vec<&'static str> {
@@ -118,6 +127,8 @@ pub mod flags {
             (WAVES_FROZEN, "waves_frozen"),
             (WAVES_IMPLAUSIBLE, "waves_implausible"),
             (MODEL_SPEED_MISMATCH, "model_speed_mismatch"),
+            (MOTION_SETTLING, "motion_settling"),
+            (MOTION_CLOCK_APART, "motion_clock_apart"),
         ]
         .iter()
         .filter(|(b, _)| f & b != 0)

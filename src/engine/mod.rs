@@ -186,6 +186,11 @@ pub struct Engine {
     job_offset: Vec<[f64; 6]>,
     /// Per vessel, whether the running job started it from rest for want of fresh motion.
     job_unknown: Vec<bool>,
+    /// Per vessel, whether the running job's start of it, or of a vessel coupled to it, is settling
+    /// after a restart (`Estimator::settling`): trusted nowhere, nothing learnt.
+    job_withdrawn: Vec<bool>,
+    /// Which vessels the model couples ([`setup::coupled_vessels`]).
+    coupled: Vec<Vec<bool>>,
     /// The measured trace the in-situ roll tuning scores its cases against (time, every series).
     trace: std::collections::VecDeque<(f64, Vec<f64>)>,
     /// Per vessel, the roll tuning in force (damping, quadratic, frequency; [`crate::tuning`]), and
@@ -259,6 +264,8 @@ impl Engine {
             heel_time_s: None,
             job_offset: vec![[0.0; 6]; n_bodies],
             job_unknown: vec![false; n_bodies],
+            job_withdrawn: vec![false; n_bodies],
+            coupled: setup::coupled_vessels(model, n_bodies),
             trace: std::collections::VecDeque::new(),
             roll_tuning: [[0.0; 3]; MAX_VESSELS],
             roll_tuning_converged: false,

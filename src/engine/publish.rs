@@ -27,13 +27,22 @@ impl Engine {
                 // untrusted field's error is its waves'), with or without a trusted span
                 let n = (header.steps as usize + 1) * header.n_series as usize;
                 let unknown = self.job_unknown.iter().any(|u| *u);
-                let trusted = d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share && !unknown;
+                // a start settling after a restart (and all it is coupled to) teaches nothing and is
+                // trusted nowhere: it may be off by the jump
+                let withdrawn = self.job_withdrawn.iter().any(|w| *w);
+                for (b, _) in self.job_withdrawn.iter().enumerate().filter(|(_, w)| **w) {
+                    header.set_span(b, 0.0, 0.0);
+                }
+                let trusted =
+                    d.teaches && d.dropped_wave_share <= self.cfg.max_dropped_wave_share && !unknown && !withdrawn;
                 let mut values = values;
                 if unknown {
                     self.unknown_start(&mut header, &mut values, &d.motion_sigma, &d.model_error);
                 }
                 if values.len() == 2 * n {
-                    self.learn_model_mean(&header, &values[..n]);
+                    if !withdrawn {
+                        self.learn_model_mean(&header, &values[..n]);
+                    }
                     self.shift_to_measured_mean(&header, &mut values[..n]);
                 }
                 if values.len() == 2 * n && trusted {

@@ -139,3 +139,52 @@ pub fn watchdog_fits(period_s: f64, watchdog_s: Option<f64>) -> Result<(), Strin
         _ => Ok(()),
     }
 }
+
+/// A coupling term counts when it is this share of the geometric mean of the two diagonal terms it
+/// joins: hulls far apart keep BEM round-off between them.
+const COUPLING_SHARE: f64 = 1e-6;
+
+/// Which vessels the model couples, transitively (each with itself): a connection between them, or
+/// inertia, damping or stiffness between their rows. A vessel's bad start reaches every vessel
+/// coupled to it.
+pub fn coupled_vessels(model: &TimeModel, n_bodies: usize) -> Vec<Vec<bool>> {
+    let mut c = vec![vec![false; n_bodies]; n_bodies];
+    for (b, row) in c.iter_mut().enumerate() {
+        row[b] = true;
+    }
+    let body = |row: usize| Some(model.active[row] / 6).filter(|b| *b < n_bodies && model.active[row] < 6 * n_bodies);
+    for m in [&model.mass, &model.damping, &model.stiffness_linearized] {
+        for i in 0..m.nrows() {
+            for j in 0..m.ncols() {
+                let (Some(a), Some(b)) = (body(i), body(j)) else {
+                    continue;
+                };
+                let scale = (m[(i, i)] * m[(j, j)]).abs().sqrt();
+                if a != b && m[(i, j)].abs() > COUPLING_SHARE * scale {
+                    (c[a][b], c[b][a]) = (true, true);
+                }
+            }
+        }
+    }
+    if let Some(ext) = &model.external {
+        for conn in &ext.connections {
+            if let (Some(a), Some(b)) = (conn.a.body, conn.b.body)
+                && a < n_bodies
+                && b < n_bodies
+            {
+                (c[a][b], c[b][a]) = (true, true);
+            }
+        }
+    }
+    // transitively: a chain of three hulls carries a bad start end to end
+    for k in 0..n_bodies {
+        for i in 0..n_bodies {
+            for j in 0..n_bodies {
+                if c[i][k] && c[k][j] {
+                    c[i][j] = true;
+                }
+            }
+        }
+    }
+    c
+}

@@ -74,6 +74,7 @@ impl Engine {
                 self.busy = true;
                 self.job_offset = start.offset;
                 self.job_unknown = motion_fresh.iter().map(|f| !f).collect();
+                self.job_withdrawn = self.withdrawn();
                 job = Some(Job {
                     t0_s: t0,
                     x0: start.x0,
@@ -88,7 +89,11 @@ impl Engine {
                     start_offset: start.start_offset,
                     check_var: start.check_var,
                     track: pose.track,
-                    tune: self.tune_input(t0, trustworthy && motion_fresh.iter().all(|f| *f), fl),
+                    tune: self.tune_input(
+                        t0,
+                        trustworthy && motion_fresh.iter().all(|f| *f) && fl & flags::MOTION_SETTLING == 0,
+                        fl,
+                    ),
                     header,
                 });
             }
@@ -114,9 +119,12 @@ impl Engine {
         // down) does not stop the others' forecasts: the model starts it from rest at its mean in
         // waves, it is trusted nowhere and its band is the motion's own, and its error reaches the
         // fresh vessels through the coupling (lines, fenders, the water between them)
-        let motion_fresh: Vec<bool> = (0..self.n_bodies)
+        let mut motion_fresh: Vec<bool> = (0..self.n_bodies)
             .map(|b| motion_ok[b] && self.hist[b].newest_time_s().is_some())
             .collect();
+        if self.drop_clocks_apart(&mut motion_fresh) {
+            fl |= flags::MOTION_CLOCK_APART;
+        }
         let (t0, newest) = self.newest_motion_of(&motion_fresh);
         // the sources' clocks must agree: vessels' newest motion within the staleness and the skew of
         // each other, and no wave field from after the motion beyond the skew
@@ -131,6 +139,9 @@ impl Engine {
         }
         if self.waves_frozen {
             fl |= flags::WAVES_FROZEN;
+        }
+        if self.hist.iter().any(|h| h.settling()) {
+            fl |= flags::MOTION_SETTLING;
         }
         // ages are never negative: a field stamped a little after the newest motion (within the
         // clocks' skew) is taken as current. With no vessel's motion fresh, the waves' age is taken
@@ -161,6 +172,44 @@ impl Engine {
             t0_s: t0,
             can,
         }
+    }
+
+    /// Each vessel's motion clock judged alone against the radar's (the other ship's, over the link,
+    /// may be wrong while this ship's is right): a fresh vessel whose newest motion is behind the newest
+    /// field beyond the clocks' skew, or ahead of it beyond `suppress_wave_age_s` and the skew, is
+    /// taken as stale, if another fresh vessel's agrees. Whether any was.
+    fn drop_clocks_apart(&self, motion_fresh: &mut [bool]) -> bool {
+        let Some(field_s) = self.field.as_ref().map(|f| f.time_s) else {
+            return false;
+        };
+        let skew = self.cfg.max_clock_skew_s;
+        let apart: Vec<bool> = (0..self.n_bodies)
+            .map(|b| {
+                motion_fresh[b]
+                    && self.hist[b]
+                        .newest_time_s()
+                        .is_some_and(|t| field_s - t > skew || t - field_s > self.cfg.suppress_wave_age_s + skew)
+            })
+            .collect();
+        let agree = (0..self.n_bodies).any(|b| motion_fresh[b] && !apart[b]);
+        if !agree || !apart.iter().any(|a| *a) {
+            return false;
+        }
+        for (b, a) in apart.iter().enumerate() {
+            if *a {
+                motion_fresh[b] = false;
+                tracing::debug!(vessel = b, "motion clock apart from the radar's: forecast from rest");
+            }
+        }
+        true
+    }
+
+    /// Per vessel, whether its start or that of a vessel coupled to it is settling after a restart
+    /// (`Estimator::settling`): the start may be off by the jump, and the coupling carries it.
+    fn withdrawn(&self) -> Vec<bool> {
+        (0..self.n_bodies)
+            .map(|b| (0..self.n_bodies).any(|o| self.coupled[b][o] && self.hist[o].settling()))
+            .collect()
     }
 
     /// The measured state at `t0` of every vessel, its start error and (roll, pitch) its heel; None when
@@ -270,7 +319,13 @@ impl Engine {
     /// may be heel is in the band at the start, [`band::heel_split`]), with the measured mean where
     /// roll or pitch keeps a heel (gravity-referenced: part of what the forecast leaves out of it as
     /// bias may be heel, and a forecast settles to the model's equilibrium whatever its start).
+    /// While an estimate settles after a restart its measured motion is off by the jump: the
+    /// checks wait (the pending forecasts are checked once it has settled, against the motion as
+    /// then known).
     fn learn_model_error(&mut self, t0: f64) {
+        if self.hist.iter().any(|h| h.settling()) {
+            return;
+        }
         let (dt, max_gap_s) = (self.dt_s, self.cfg.max_gap_s);
         let (hist, model_mean, angle_bias_rad) = (&self.hist, &self.model_mean, self.angle_bias_rad);
         self.model_error.observe(t0, |t| {

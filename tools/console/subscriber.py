@@ -49,6 +49,8 @@ FLAGS = [
     "waves_frozen",
     "waves_implausible",
     "model_speed_mismatch",
+    "motion_settling",
+    "motion_clock_apart",
 ]
 
 
