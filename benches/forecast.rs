@@ -57,6 +57,7 @@ fn benches(c: &mut Criterion) {
                     trusted_nrmse: 0.6,
                     start_var: vec![],
                     start_offset: vec![],
+                    coupled_var: vec![],
                 };
                 let steps = (300.0 / model.opts.dt_s).round() as usize;
                 g.bench_function(format!("{name}_band"), |b| {

@@ -23,6 +23,8 @@ pub struct ShipcastConfig {
     #[serde(default)]
     pub record: RecordConfig,
     #[serde(default)]
+    pub state: StateConfig,
+    #[serde(default)]
     pub simulate: SimulateConfig,
     #[serde(default)]
     pub operation: OperationConfig,
@@ -247,6 +249,26 @@ impl Default for RecordConfig {
             dir: String::new(),
             rotate_mb: 256.0,
             rotate_s: None,
+        }
+    }
+}
+
+/// What the daemon keeps of its learnt state across a restart ([`crate::engine::state`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct StateConfig {
+    /// Directory of the state file (relative to the config file); empty: systemd's
+    /// `STATE_DIRECTORY` when it sets one, else none is kept.
+    pub dir: String,
+    /// The state is written this often, s (and at a clean stop).
+    pub every_s: f64,
+}
+
+impl Default for StateConfig {
+    fn default() -> Self {
+        StateConfig {
+            dir: String::new(),
+            every_s: 60.0,
         }
     }
 }

@@ -841,3 +841,82 @@ fn a_hung_computation_is_no_longer_fed_to_the_watchdog() {
         "{err}"
     );
 }
+
+/// A daemon killed and back (issue 53, item 2), live: it takes back the state it kept (`[state]`,
+/// here every 2 s) and trusts a forecast within 15 s, where its first start took the model error's
+/// first checks; a corrupt state file is refused with a line naming it, and the daemon starts cold.
+#[test]
+fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
+    use std::io::Read;
+    let dir = crate::util::scratch_dir("daemon-warm");
+    let cfg = config(&dir, "warm", "[state]\ndir = \"state\"\nevery_s = 2.0\n");
+    let names = Names {
+        prefix: format!("shipcast-test-{}-warm", std::process::id()),
+    };
+    let mut d = daemon(&cfg);
+    let _sim = simulator(&cfg, "1200", &[]);
+    let sub = ForecastSubscriber::new(&names).unwrap();
+    // wall seconds until a forecast issued after `after_s` (data clock) that trusts the ship arrives
+    // (None: not within `limit_s`), and the newest issue time read
+    let trusted_within = |limit_s: f64, after_s: f64| -> (Option<f64>, f64) {
+        let t = Instant::now();
+        let mut got = vec![];
+        let mut newest_s = after_s;
+        while t.elapsed().as_secs_f64() < limit_s {
+            got.clear();
+            sub.wait(Duration::from_millis(200), &mut got).unwrap();
+            for r in &got {
+                if let Received::Forecast(h, _) = r
+                    && h.issue_time_s > after_s
+                {
+                    newest_s = newest_s.max(h.issue_time_s);
+                    if h.horizon_s[0] > 0.0 {
+                        return (Some(t.elapsed().as_secs_f64()), newest_s);
+                    }
+                }
+            }
+        }
+        (None, newest_s)
+    };
+    let (cold_s, _) = trusted_within(90.0, f64::NEG_INFINITY);
+    let cold_s = cold_s.expect("the first start trusts a forecast");
+    // a few saves of the learnt state, then a crash; what it published before is read and passed over
+    std::thread::sleep(Duration::from_secs(5));
+    d.kill();
+    let mut last_s = f64::NEG_INFINITY;
+    let mut got = vec![];
+    let quiet = Instant::now();
+    while quiet.elapsed() < Duration::from_secs(2) {
+        got.clear();
+        sub.wait(Duration::from_millis(200), &mut got).unwrap();
+        for r in &got {
+            if let Received::Forecast(h, _) = r {
+                last_s = last_s.max(h.issue_time_s);
+            }
+        }
+    }
+    let path = dir.join("state").join(shipcast::shell::state::FILE_NAME);
+    assert!(path.exists(), "no state kept at {}", path.display());
+    let mut back = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    let (warm_s, _) = trusted_within(30.0, last_s);
+    eprintln!(
+        "a forecast trusted {cold_s:.1} s after the first start, {warm_s:?} s after the restart (wall; data at 4 x; the killed daemon's last forecast at {last_s:.1} s)"
+    );
+    assert!(
+        warm_s.is_some_and(|w| w <= 15.0 && w < cold_s),
+        "warm {warm_s:?}, cold {cold_s}"
+    );
+    back.kill();
+    // a corrupt state: refused, named, a cold start
+    std::fs::write(&path, b"shipcast state\n\x07\x07\x07").unwrap();
+    let mut corrupt = spawn(&["run", "--config", cfg.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_secs(4));
+    corrupt.kill();
+    let mut err = String::new();
+    corrupt.0.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    assert!(
+        err.contains("corrupt") && err.contains("cold start") && err.contains(&path.display().to_string()),
+        "{err}"
+    );
+}

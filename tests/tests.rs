@@ -30,6 +30,7 @@ mod trust;
 mod tuning;
 mod two_ship_demo;
 mod underway;
+mod warm_start;
 mod waves_fields;
 mod wecsim_rm3;
 mod wecsim_rm3_3dof;

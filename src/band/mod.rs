@@ -2,7 +2,8 @@
 //! it is trusted, the model error learnt from past forecasts, the start's error (the sensor's bias
 //! or a heel), and the normal distribution's tails. Files: `response` (the model's response table),
 //! `span` (the band and the span of one forecast), `model_error` (learning from checks),
-//! `start` (the start's error and heel), `normal`.
+//! `start` (the start's error and heel), `coupling` (what a coupled vessel's unknown start adds),
+//! `normal`.
 //!
 //! A forecast knows a wave component only over the leads at which the water that brings it to the
 //! vessel had been observed (`waves::horizon::known_leads`: for a radar, while that water was inside
@@ -42,6 +43,7 @@
 //! rad; headings of waves relative to the vessel's +x, travel-to, counterclockwise; series-major output
 //! as on the wire (6 series per vessel, steps + 1 values each).
 
+mod coupling;
 mod model_error;
 mod normal;
 mod response;
@@ -50,6 +52,7 @@ mod start;
 #[cfg(test)]
 mod tests;
 
+pub use coupling::*;
 pub use model_error::*;
 pub use normal::*;
 pub use response::*;

@@ -42,7 +42,7 @@ pub(super) const MIN_SIGNAL_TO_NOISE: f64 = 9.0;
 
 /// A forecast waiting to be checked: at each check lead (the first `values.len()` of
 /// [`CHECK_LEADS_S`]), its values there and the variance of the waves it did not know.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct Pending {
     issue_s: f64,
     dt_s: f64,
@@ -67,7 +67,7 @@ pub(super) struct Pending {
 /// instead); and the motion's own variance, as measured. It takes in what a wave-by-wave account
 /// leaves out: the model's own error, the inversion's frequency error that grows with lead, the
 /// initial state's. Pure: forecasts and measurements in, variances out.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModelError {
     prior: f64,
     n_series: usize,

@@ -45,6 +45,9 @@ pub struct SpreadOptions {
     /// Per series, the expected error of the start (truth less forecast: the part of a measured mean
     /// the forecast leaves out as the sensor's bias that is more likely heel), m or rad; missing: 0.
     pub start_offset: Vec<f64>,
+    /// Per series and step (series-major, `steps + 1` each), the variance a coupled vessel's unknown
+    /// start adds ([`super::coupled_var`]); empty: none.
+    pub coupled_var: Vec<f64>,
 }
 
 /// A forecast's band and trusted span.
@@ -273,7 +276,8 @@ pub(super) fn band_sigma(
             let unknown = (acc + rate * k as f64).max(0.0);
             let learnt = ((unknown + floor) * scale * scale).max(start0);
             let r = after_start(lead_s);
-            let var = r * learnt + (1.0 - r) * sigma0 * sigma0;
+            let coupled = opts.coupled_var.get(i * n + k).copied().unwrap_or(0.0);
+            let var = r * learnt + (1.0 - r) * sigma0 * sigma0 + coupled;
             sigma.push(var.sqrt());
             // the span judges the error's expected mean square, not the band: the band's scale
             // makes it hold nine checks in ten (narrow-band errors, a resonant roll's, have their
@@ -282,7 +286,7 @@ pub(super) fn band_sigma(
             let se = opts.model_error.var_se_at(i, learnt_lead_s);
             let mean_square = (unknown + floor + SPAN_CONFIDENCE_Z * se).max(start0);
             span_sigma.push(if learnt_lead_s <= opts.model_error.checked_to_s {
-                (r * mean_square + (1.0 - r) * sigma0 * sigma0).sqrt()
+                (r * mean_square + (1.0 - r) * sigma0 * sigma0 + coupled).sqrt()
             } else {
                 f64::INFINITY
             });

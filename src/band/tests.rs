@@ -119,6 +119,7 @@ fn the_band_at_lead_0_holds_the_start_s_offset_and_its_own_error_not_the_sensor_
         trusted_nrmse: 0.6,
         start_var: vec![1e-6],
         start_offset: vec![0.002],
+        coupled_var: vec![],
     };
     let s = spread(&table, &[], &[], 1, 0.0, 9.81, None, 20, 0.5, &opts);
     assert!((s.sigma[0] - h / Z90).abs() < 1e-7, "{}", s.sigma[0]);
@@ -317,6 +318,7 @@ fn the_band_widens_where_components_are_unknown_and_the_span_is_where_the_expect
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let s = spread(&table, &waves, &known, 1, 0.0, 9.81, None, 100, 1.0, &opts);
     let heave = &s.sigma[2 * 101..3 * 101];
@@ -366,6 +368,7 @@ fn span_after_checks(amplitude: impl Fn(usize) -> f64) -> (ModelErrorCurve, Spre
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, n - 1, dt, &opts);
     (curve, s)
@@ -408,6 +411,7 @@ fn a_span_trusts_no_lead_its_model_error_has_not_been_checked_at() {
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let mut moving = ModelErrorCurve::prior(0.15, 6);
     moving.motion_var[2] = 1.0;
@@ -457,6 +461,7 @@ fn the_span_judges_the_expected_rms_error_not_the_band_scaled_for_its_coverage()
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, 20, 0.5, &opts);
     assert!((s.sigma[2 * 21 + 10] - 0.42f64.sqrt() * 0.8).abs() < 1e-12);
@@ -495,6 +500,7 @@ fn a_component_unknown_from_the_start_errs_by_nothing_at_lead_0_and_builds_up_ov
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let heave = |known: [f64; 2]| {
         let s = spread(&table, &wave, &[vec![known]], 1, 0.0, 9.81, None, 60, 1.0, &opts);
@@ -539,6 +545,7 @@ fn a_calm_vessel_is_trusted_throughout_and_garbage_amplitudes_are_left_out() {
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let s = spread(&table, &waves, &[vec![[0.0, 0.0]]], 1, 0.0, 9.81, None, 10, 1.0, &opts);
     assert!(s.sigma.iter().all(|x| *x == 0.0));
@@ -555,6 +562,7 @@ fn each_series_has_its_own_span_and_one_that_errs_does_not_shorten_the_others() 
         trusted_nrmse: 0.6,
         start_var: vec![],
         start_offset: vec![],
+        coupled_var: vec![],
     };
     let s = spread(&flat_table(6, 1.0), &[], &[], 1, 0.0, 9.81, None, 40, 0.5, &opts);
     assert!(s.to_s[0] < 10.0, "{:?}", s.to_s);

@@ -57,7 +57,7 @@ pub enum Stamp {
 }
 
 /// One source's clock.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SourceClock {
     /// Reference offset (stamp - engine clock) and the engine time it was last moved, s.
     reference: Option<(f64, f64)>,

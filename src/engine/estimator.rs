@@ -210,7 +210,7 @@ pub enum Taken {
 }
 
 /// One DOF's Gaussian: mean (displacement, velocity) and covariance (pp, pv, vv).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 struct Gauss {
     m: [f64; 2],
     p: [f64; 3],
@@ -267,7 +267,7 @@ fn times_inverse(a: [f64; 4], s: [f64; 3]) -> Option<[f64; 4]> {
 }
 
 /// One sample the filter took.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Entry {
     time_s: f64,
     /// The measurement (for the raw method and the bias).
@@ -296,7 +296,7 @@ pub struct Resampled {
 /// A running mean of 6 DOFs over the last `tau_s` of what it was given (over all of it until then):
 /// each value counts for the time since the one before. The estimator's bias; the engine's mean of
 /// its model's own forecasts.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunningMean {
     pub value: [f64; 6],
     /// The time the mean has been taken over, s.
@@ -324,7 +324,7 @@ impl RunningMean {
 /// A hindsight check of the start at one instant ([`Estimator::start_var`]): the Hann-weighted sums
 /// of the samples within [`HINDSIGHT_HALF_WINDOW_S`] of it, the sums of a quadratic fit to those
 /// within [`HINDSIGHT_FIT_HALF_S`], and the start the estimator took at the first sample from it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Check {
     centre_s: f64,
     weight: f64,
@@ -433,6 +433,14 @@ pub struct Estimator {
     jump: Option<Jump>,
 }
 
+/// What an estimator keeps across a restart of the daemon ([`Estimator::state`]).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct EstimatorState {
+    learnt: Learnt,
+    learned: RunningMean,
+    moved: bool,
+}
+
 /// A restart from a jump: when, how far the first sample of the run was from the old estimate's
 /// prediction per DOF, and (for [`REVERT_WINDOW_S`]) the estimate before it.
 #[derive(Debug, Clone)]
@@ -443,7 +451,7 @@ struct Jump {
 }
 
 /// What an estimate has learnt from its samples: what a restart forgets and a revert restores.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 struct Learnt {
     entries: VecDeque<Entry>,
     bias: RunningMean,
@@ -480,6 +488,42 @@ impl Estimator {
         self.next_check_s = None;
         if let Some(j) = &mut self.jump {
             j.before = None;
+        }
+    }
+
+    /// What the estimate has learnt, to be kept across a restart of the daemon
+    /// ([`Estimator::restore`]): the kept samples, the bias, the innovations, the hindsight checks and
+    /// what they learnt (a run of refused samples and a restart's settling are not kept).
+    pub fn state(&self) -> EstimatorState {
+        EstimatorState {
+            learnt: Learnt {
+                entries: self.entries.clone(),
+                bias: self.bias,
+                innovation: self.innovation,
+                checks: self.checks.clone(),
+                next_check_s: self.next_check_s,
+            },
+            learned: self.learned,
+            moved: self.moved,
+        }
+    }
+
+    /// Takes back what [`Estimator::state`] kept (samples older than the kept window go).
+    pub fn restore(&mut self, s: EstimatorState) {
+        let l = s.learnt;
+        self.entries = l.entries;
+        self.bias = l.bias;
+        self.innovation = l.innovation;
+        self.checks = l.checks;
+        self.next_check_s = l.next_check_s;
+        self.learned = s.learned;
+        self.moved = s.moved;
+        self.candidate.clear();
+        self.jump = None;
+        if let Some(t) = self.newest_time_s() {
+            while self.entries.front().is_some_and(|f| t - f.time_s > self.keep_s) && self.entries.len() > 2 {
+                self.entries.pop_front();
+            }
         }
     }
 

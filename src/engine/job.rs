@@ -37,6 +37,9 @@ pub struct Job {
     pub(super) header: ForecastHeader,
     /// What the in-situ tuning takes from this tick (None: tuning is off).
     pub(super) tune: Option<super::tune::TuneInput>,
+    /// Per vessel, whether it is started from rest for want of its motion: the vessels coupled to it
+    /// have its unknown start in their band ([`band::coupled_var`]).
+    pub(super) unknown: Vec<bool>,
 }
 
 /// A job's result.
@@ -88,6 +91,9 @@ pub struct Computer {
     length_s: f64,
     /// `forecast.drift_window_s` (0: no drift estimate).
     drift_window_s: f64,
+    /// Per vessel, the model's free response to its start's error, made when first wanted (a vessel
+    /// without motion) and forgotten when the model changes.
+    coupling: Vec<Option<band::CouplingResponse>>,
 }
 
 impl Computer {
@@ -112,6 +118,7 @@ impl Computer {
             n_bodies,
             length_s: cfg.forecast.horizon_s,
             drift_window_s: cfg.forecast.drift_window_s,
+            coupling: vec![None; n_bodies],
         }
     }
 
@@ -147,6 +154,7 @@ impl Computer {
             "model rebuilt for the forward speed (its speed terms)"
         );
         self.table = response_table(&model);
+        self.coupling = vec![None; self.n_bodies];
         self.tuning.reset(&model);
         self.base = model.clone();
         self.model = model;
@@ -300,13 +308,61 @@ impl Computer {
     }
 
     /// The job's band and trusted span over `steps` (None without the response table: nothing trusted).
-    fn band(&self, job: &Job, steps: usize) -> Option<band::Spread> {
-        let opts = SpreadOptions {
+    /// With a vessel started from rest for want of its motion, the others' band holds what its
+    /// unknown start does to them through the coupling ([`band::coupled_var`]).
+    fn band(&mut self, job: &Job, steps: usize) -> Option<band::Spread> {
+        let mut opts = SpreadOptions {
             model_error: job.model_error.clone(),
             trusted_nrmse: self.trusted_nrmse,
             start_var: job.start_var.clone(),
             start_offset: job.start_offset.clone(),
+            coupled_var: vec![],
         };
+        let alone = self.spread_with(job, steps, &opts)?;
+        if !job.unknown.iter().any(|u| *u) {
+            return Some(alone);
+        }
+        let omega_rad_s = band::mean_omega_rad_s(&job.waves);
+        for (b, _) in job.unknown.iter().enumerate().filter(|(_, u)| **u) {
+            let probe = band::significant(&alone.motion_sigma, b);
+            let kept = self.coupling.get(b).and_then(|c| c.as_ref());
+            if kept.is_some_and(|c| c.serves(&probe, omega_rad_s, steps)) || b >= self.coupling.len() {
+                continue;
+            }
+            let history = job.velocities.len();
+            let made = band::free_responses(
+                &self.model,
+                &mut self.fc,
+                b,
+                self.n_bodies,
+                self.length_s,
+                history,
+                probe,
+                omega_rad_s,
+            );
+            match made {
+                Ok(r) => self.coupling[b] = Some(r),
+                Err(e) => {
+                    tracing::warn!(
+                        vessel = b,
+                        "no free response for the coupled band ({e}): nothing trusted"
+                    );
+                    return Some(untrusted(alone));
+                }
+            }
+        }
+        let responses: Vec<&band::CouplingResponse> = job
+            .unknown
+            .iter()
+            .zip(&self.coupling)
+            .filter_map(|(u, c)| c.as_ref().filter(|_| *u))
+            .collect();
+        opts.coupled_var = band::coupled_var(&responses, self.n_bodies, steps);
+        self.spread_with(job, steps, &opts)
+    }
+
+    /// [`band::spread`] of a job with `opts`.
+    fn spread_with(&self, job: &Job, steps: usize, opts: &SpreadOptions) -> Option<band::Spread> {
         let model = &self.model;
         self.table.as_ref().map(|table| {
             band::spread(
@@ -319,10 +375,20 @@ impl Computer {
                 model.water_depth_m,
                 steps,
                 model.opts.dt_s,
-                &opts,
+                opts,
             )
         })
     }
+}
+
+/// A spread with no span trusted.
+fn untrusted(mut s: band::Spread) -> band::Spread {
+    s.from_s.iter_mut().chain(&mut s.to_s).for_each(|x| *x = 0.0);
+    s.series_from_s
+        .iter_mut()
+        .chain(&mut s.series_to_s)
+        .for_each(|x| *x = 0.0);
+    s
 }
 
 impl Computer {
@@ -331,6 +397,7 @@ impl Computer {
     pub fn tune(&mut self) {
         if let Some(model) = self.tuning.work(&self.base) {
             self.table = response_table(&model);
+            self.coupling = vec![None; self.n_bodies];
             self.model = model;
         }
     }

@@ -17,6 +17,7 @@ mod input;
 mod job;
 mod publish;
 mod setup;
+pub mod state;
 mod tick;
 mod tune;
 
@@ -191,6 +192,8 @@ pub struct Engine {
     job_withdrawn: Vec<bool>,
     /// Which vessels the model couples ([`setup::coupled_vessels`]).
     coupled: Vec<Vec<bool>>,
+    /// The model's inertia (M + A_inf) diagonal, for [`Engine::fingerprint`].
+    inertia_digest: String,
     /// The measured trace the in-situ roll tuning scores its cases against (time, every series).
     trace: std::collections::VecDeque<(f64, Vec<f64>)>,
     /// Per vessel, the roll tuning in force (damping, quadratic, frequency; [`crate::tuning`]), and
@@ -266,6 +269,10 @@ impl Engine {
             job_unknown: vec![false; n_bodies],
             job_withdrawn: vec![false; n_bodies],
             coupled: setup::coupled_vessels(model, n_bodies),
+            inertia_digest: (0..model.mass.nrows())
+                .map(|i| format!("{:.6e}", model.mass[(i, i)]))
+                .collect::<Vec<_>>()
+                .join(" "),
             trace: std::collections::VecDeque::new(),
             roll_tuning: [[0.0; 3]; MAX_VESSELS],
             roll_tuning_converged: false,

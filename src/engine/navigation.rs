@@ -29,7 +29,7 @@ pub const MIN_TREND_SHARE: f64 = 0.5;
 const KEEP_MARGIN_S: f64 = 5.0;
 
 /// One fix, in the earth frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Fix {
     pub time_s: f64,
     /// Reference point, m east and north.
@@ -102,7 +102,7 @@ pub struct Pose {
 }
 
 /// One vessel's recent fixes.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct NavTrack {
     fixes: VecDeque<Fix>,
     /// Whether any fix was ever taken.

@@ -89,6 +89,7 @@ impl Engine {
                     start_offset: start.start_offset,
                     check_var: start.check_var,
                     track: pose.track,
+                    unknown: motion_fresh.iter().map(|f| !f).collect(),
                     tune: self.tune_input(
                         t0,
                         trustworthy && motion_fresh.iter().all(|f| *f) && fl & flags::MOTION_SETTLING == 0,

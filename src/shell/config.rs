@@ -226,6 +226,7 @@ pub const BOUNDS: &[Bound] = &[
     // a terabyte of messages per file at most
     positive("record.rotate_mb", 1.0e6, "MB"),
     positive("record.rotate_s", 30.0 * DAY_S, "s"),
+    positive("state.every_s", DAY_S, "s"),
     // the simulation's truth is kept whole: a week at 10 Hz is about 6 million samples per DOF
     positive("simulate.duration_s", 7.0 * DAY_S, "s"),
     positive("simulate.speed", 1000.0, ""),
@@ -357,6 +358,7 @@ fn estimator_link_record_numbers(c: &ShipcastConfig) -> Vec<Number> {
         one("estimator.drift_time_s", c.estimator.drift_time_s),
         one("record.rotate_mb", c.record.rotate_mb),
         ("record.rotate_s", "record.rotate_s".into(), c.record.rotate_s),
+        one("state.every_s", c.state.every_s),
     ]
 }
 

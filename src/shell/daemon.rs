@@ -226,6 +226,11 @@ pub async fn run(
     // log times are this clock, so they line up with the ship's other logs)
     let clock_anchor_s = wall_s();
     let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
+    let state_path = crate::shell::state::path(&cfg);
+    if let Some(p) = &state_path {
+        warm_start(&mut engine, p, clock());
+    }
+    let mut state_saved_s = clock();
     // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
     // decision); a write error is logged and ends the recording, never the daemon
     let mut recorder = open_recorder(&cfg, &sys);
@@ -289,11 +294,22 @@ pub async fn run(
                     outstanding = Some(Instant::now());
                 }
                 let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), true)));
+                if let Some(p) = &state_path && t - state_saved_s >= cfg.state.every_s {
+                    state_saved_s = t;
+                    let (p, state) = (p.clone(), engine.state(t));
+                    // written off the loop: a few megabytes
+                    tokio::task::spawn_blocking(move || keep_state(&p, &state));
+                }
             }
         }
     }
     stop.store(true, Ordering::Relaxed);
     let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), false)));
+    if let Some(p) = &state_path
+        && failure.is_none()
+    {
+        keep_state(p, &engine.state(clock()));
+    }
     finish(th, recorder, &engine, hung);
     match failure {
         Some(why) => Err(why.to_string().into()),
@@ -302,6 +318,31 @@ pub async fn run(
 }
 
 /// The compute thread is hung when a job has been outstanding this long, s: with a watchdog, its
+/// Takes the learnt state kept at `path` into the engine, or says why not (the daemon then starts
+/// cold).
+fn warm_start(engine: &mut Engine, path: &std::path::Path, clock_s: f64) {
+    match crate::shell::state::read(path) {
+        Ok(None) => tracing::info!(path = %path.display(), "no state kept: a cold start"),
+        Ok(Some(s)) => {
+            let age_s = clock_s - s.clock_s;
+            match engine.restore(s, clock_s) {
+                Ok(()) => {
+                    tracing::info!(path = %path.display(), age_s, "warm start: the learnt state kept {age_s:.1} s ago taken back")
+                }
+                Err(why) => tracing::warn!(path = %path.display(), "{why}: refused, a cold start"),
+            }
+        }
+        Err(e) => tracing::warn!("{e}: refused, a cold start"),
+    }
+}
+
+/// Writes the learnt state, logging a failure (the daemon goes on).
+fn keep_state(path: &std::path::Path, state: &crate::engine::state::EngineState) {
+    if let Err(e) = crate::shell::state::write(path, state) {
+        tracing::warn!("the learnt state was not kept: {e}");
+    }
+}
+
 /// interval less two periods (the last ping before it then lands inside the interval, and systemd acts
 /// one interval later), at least half of it; without, 30 s (said, nothing else acts on it).
 fn hung_after_s(period_s: f64, watchdog_s: Option<f64>) -> f64 {

@@ -20,14 +20,30 @@ pub fn drive(
     cfg: &crate::shell::config::ShipcastConfig,
     sys: &crate::hydro::VesselSystem,
     records: &[(f64, Record)],
+    pace: impl FnMut(f64),
+    on_output: impl FnMut(crate::shell::ipc::Output),
+) -> Result<crate::engine::Counters, Error> {
+    drive_from(cfg, sys, records, None, pace, on_output).map(|(c, _)| c)
+}
+
+/// [`drive`] from a kept learnt state (as the daemon takes it at start, at the first record's time;
+/// refused: an error), returning the state at the end too (at the last record's time).
+pub fn drive_from(
+    cfg: &crate::shell::config::ShipcastConfig,
+    sys: &crate::hydro::VesselSystem,
+    records: &[(f64, Record)],
+    state: Option<crate::engine::state::EngineState>,
     mut pace: impl FnMut(f64),
     mut on_output: impl FnMut(crate::shell::ipc::Output),
-) -> Result<crate::engine::Counters, Error> {
+) -> Result<(crate::engine::Counters, crate::engine::state::EngineState), Error> {
     use crate::engine::{Computer, Engine, rom_options};
     use crate::shell::ipc::{Input, Output};
     crate::engine::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
+    if let (Some(s), Some((t, _))) = (state, records.first()) {
+        engine.restore(s, *t).map_err(|why| Error::from(why.to_string()))?;
+    }
     let mut computer = Computer::new(model, sys, cfg);
     let period = cfg.forecast.period_s;
     // ticks on the grid t0 + k period; past this long after the last input no tick can issue a forecast
@@ -90,5 +106,6 @@ pub fn drive(
             Record::Truth(_) | Record::Forecast(_) | Record::Tick(_) => {}
         }
     }
-    Ok(engine.counters.clone())
+    let end_s = records.last().map_or(0.0, |(t, _)| *t);
+    Ok((engine.counters.clone(), engine.state(end_s)))
 }
