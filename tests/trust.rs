@@ -880,3 +880,52 @@ fn a_sensor_re_zeroed_is_not_trusted_until_its_new_offset_is_known() {
         "the status says the estimate is settling"
     );
 }
+
+/// How long the motion is away in [`a_motion_outage_keeps_the_history_before_it`], s: longer than
+/// `forecast.max_gap_s` (the other ship's link down, a sensor restarted).
+const OUTAGE_S: f64 = 10.0;
+
+/// Was: motion back after an outage longer than `forecast.max_gap_s` restarted the history there, and
+/// every forecast said `history_short` until the radiation memory had refilled (60 s here, 600 s for
+/// the moored pair). Now the history before the outage is kept, the outage itself at rest
+/// (`history_gap` while it is inside the memory), and the forecasts start as before.
+#[test]
+fn a_motion_outage_keeps_the_history_before_it() {
+    let l = log();
+    let t0 = start(&l.records);
+    let gone = (t0 + FAULT_AT_S, t0 + FAULT_AT_S + OUTAGE_S);
+    let records: Vec<(f64, Record)> = l
+        .records
+        .iter()
+        .filter(|(t, r)| !(matches!(r, Record::Motion(_)) && *t > gone.0 && *t < gone.1))
+        .cloned()
+        .collect();
+    let run = drive(&records);
+    invariants(&run);
+    let back: Vec<&(ForecastHeader, Vec<f64>)> = run
+        .forecasts
+        .iter()
+        .filter(|(h, _)| {
+            h.issue_time_s > gone.1 + 1.0 && h.issue_time_s < gone.0 + l.cfg.forecast.memory_s.unwrap_or(60.0)
+        })
+        .collect();
+    assert!(back.len() > 20, "{} forecasts after the outage", back.len());
+    for (h, v) in &back {
+        assert_eq!(
+            h.flags & flags::HISTORY_SHORT,
+            0,
+            "at {:.1} s: {:?}",
+            h.issue_time_s - t0,
+            flags::names(h.flags)
+        );
+        assert!(h.flags & flags::HISTORY_GAP != 0, "{:?}", flags::names(h.flags));
+        for (dof, tol) in INITIAL_STATE_TOL {
+            let (got, truth) = (initial(h, v, dof), truth_at(&records, h.motion_time_s, dof));
+            assert!(
+                (got - truth).abs() < tol,
+                "DOF {dof} at {:.1} s: {got} against {truth}",
+                h.issue_time_s - t0
+            );
+        }
+    }
+}

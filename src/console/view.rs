@@ -328,7 +328,10 @@ fn flag_lines(c: &Console, h: &Health, out: &mut Vec<(Severity, String)>) {
         }
     }
     if h.flags.contains(&"history_gap") {
-        out.push((Severity::Caution, "A gap in the IMU data was bridged".into()));
+        out.push((
+            Severity::Caution,
+            "A gap in the motion history (bridged, or at rest where long)".into(),
+        ));
     }
     if h.flags.contains(&"numerical_trouble") {
         out.push((Severity::Alarm, "The model diverged: no forecast".into()));

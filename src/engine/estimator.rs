@@ -1024,9 +1024,10 @@ impl Estimator {
     }
 
     /// The state at `t0_s` and the `n` velocities before it at step `dt_s`; walking back from t0, a gap
-    /// up to `max_gap_s` is bridged (and flagged), a longer one ends the history: what is before it
-    /// counts as at rest (flagged short). None if t0 is after the newest sample or fewer than two are
-    /// kept. The bias is taken off the initial displacement.
+    /// up to `max_gap_s` is bridged, a longer one is taken as at rest and the history before it kept
+    /// (both flagged gap; `known` counts the velocities newer than the first long gap); before the
+    /// oldest sample kept, at rest (flagged short). None if t0 is after the newest sample or inside a
+    /// long gap, or fewer than two are kept. The bias is taken off the initial displacement.
     pub fn resample(&self, t0_s: f64, dt_s: f64, n: usize, max_gap_s: f64) -> Option<Resampled> {
         let last = self.entries.back()?;
         if t0_s > last.time_s + 1e-9 || self.entries.len() < 2 {
@@ -1048,7 +1049,8 @@ impl Estimator {
         };
         let mut j = pts.len() - 1;
         let mut ended = false;
-        // the state at t, or None where the history has ended
+        // the state at t, or None where the history has ended; inside a gap longer than `max_gap_s`
+        // (the sensor or the link away) nothing is known: at rest there, the history before it kept
         let mut at = |t: f64, out: &mut Resampled| -> Option<([f64; 6], [f64; 6])> {
             if ended {
                 out.short = true;
@@ -1066,8 +1068,7 @@ impl Estimator {
             let b = if j + 1 < pts.len() { pts[j + 1] } else { a };
             let h = b.0 - a.0;
             if h > max_gap_s {
-                ended = true;
-                out.short = true;
+                out.gap = true;
                 return None;
             }
             if h > 2.5 * nominal {
@@ -1092,17 +1093,29 @@ impl Estimator {
             }
             Some((x, v))
         };
-        if let Some((x, v)) = at(t0_s, &mut out) {
-            let bias = self.bias();
-            for d in 0..6 {
-                out.x0[d] = x[d] - bias[d];
+        match at(t0_s, &mut out) {
+            Some((x, v)) => {
+                let bias = self.bias();
+                for d in 0..6 {
+                    out.x0[d] = x[d] - bias[d];
+                }
+                out.v0 = v;
             }
-            out.v0 = v;
+            // t0 inside a long gap: no state
+            None => return None,
         }
+        // `known` counts the newest velocities up to the first long gap (what the drift estimate
+        // reads); the history before the gap is kept for the radiation memory
+        let mut unbroken = true;
         for m in 1..=n {
-            if let Some((_, v)) = at(t0_s - m as f64 * dt_s, &mut out) {
-                out.velocities[n - m] = v;
-                out.known = m;
+            match at(t0_s - m as f64 * dt_s, &mut out) {
+                Some((_, v)) => {
+                    out.velocities[n - m] = v;
+                    if unbroken {
+                        out.known = m;
+                    }
+                }
+                None => unbroken = false,
             }
         }
         Some(out)
@@ -1497,13 +1510,22 @@ mod tests {
         let r = h.resample(10.0, 0.25, 8, 3.0).unwrap();
         assert!((r.x0[2] - 10.0).abs() < 1e-12 && (r.velocities[7][0] - 9.75).abs() < 1e-12);
         assert!(!r.short && !r.gap);
-        // back across the gap: bridged with max_gap 3 s, ends the history with 1 s
+        // back across the gap: bridged with max_gap 3 s; with 1 s at rest inside it, the history
+        // before it kept, `known` up to it
         let r = h.resample(10.0, 0.5, 16, 3.0).unwrap();
         assert!(r.gap && !r.short);
         assert!((r.velocities[0][0] - 2.0).abs() < 1e-12);
+        assert_eq!(r.known, 16);
         let r = h.resample(10.0, 0.5, 16, 1.0).unwrap();
-        assert!(r.short);
-        assert_eq!(r.velocities[0], [0.0; 6]);
+        assert!(r.gap && !r.short);
+        // 10 - 0.5 m for m = 9..12 (5.5 .. 4.0) falls in the gap: at rest; 3.5 and 2.0 kept
+        assert_eq!(r.velocities[16 - 9], [0.0; 6]);
+        assert_eq!(r.velocities[16 - 12], [0.0; 6]);
+        assert!((r.velocities[16 - 13][0] - 3.5).abs() < 1e-12);
+        assert!((r.velocities[0][0] - 2.0).abs() < 1e-12);
+        assert_eq!(r.known, 8);
+        // t0 inside the long gap: no state
+        assert!(h.resample(5.0, 0.5, 4, 1.0).is_none());
         // history longer than what is kept: short
         let r = h.resample(10.0, 1.0, 20, 3.0).unwrap();
         assert!(r.short);

@@ -57,24 +57,27 @@ def at_end(curve, leads, lead):
 
 
 def summarize(j):
+    """Per vessel: heave's and roll's own trusted spans (median, `spans_s`), correlations at 30 / 60 s,
+    each channel's NRMSE at its span's end and coverage inside its span, and coverage at every lead."""
     leads = j["lead_s"]
     rows = []
     for vessel, dofs in j["vessels"].items():
-        span = (j["trusted_from_s"][vessel], j["trusted_horizon_s"][vessel])
-        inside = [i for i, l in enumerate(leads) if span[0] <= l <= span[1]] if span[1] > 0 else []
+        spans = {d: tuple(j["spans_s"][vessel][d]) for d in DOFS}
         past_zero = [i for i, l in enumerate(leads) if l > 0]
-        cov, cov_all = {}, {}
+        cov, cov_all, nrmse_end = {}, {}, {}
         for d in DOFS:
+            span = spans[d]
+            inside = [i for i, l in enumerate(leads) if span[0] <= l <= span[1]] if span[1] > 0 else []
             finite = lambda idx: [dofs[d]["coverage_90"][i] for i in idx if dofs[d]["coverage_90"][i] == dofs[d]["coverage_90"][i]]
             c = finite(inside)
             cov[d] = (min(c), max(c)) if c else None
             c = finite(past_zero)
             cov_all[d] = (min(c), max(c)) if c else None
+            nrmse_end[d] = at_end(dofs[d]["nrmse"], leads, span[1]) if span[1] > 0 else None
         rows.append(dict(
-            vessel=vessel, span=span,
+            vessel=vessel, spans=spans,
             corr={d: (at_lead(dofs[d]["correlation"], leads, 30), at_lead(dofs[d]["correlation"], leads, 60)) for d in DOFS},
-            nrmse_end={d: at_end(dofs[d]["nrmse"], leads, span[1]) if span[1] > 0 else None for d in ("heave", "roll")},
-            cov=cov, cov_all=cov_all))
+            nrmse_end=nrmse_end, cov=cov, cov_all=cov_all))
     return rows
 
 
@@ -96,8 +99,8 @@ def main():
     lines = [
         f"Config `{a.config}`, {a.duration:.0f} s per case, `{' '.join(sys.argv)}`.",
         "",
-        "| case | vessel | span (median, s) | heave corr 30 / 60 s | roll corr 30 / 60 s | heave / roll NRMSE at the span's end (linear between scored leads) | coverage_90 inside the span: heave; roll; pitch | coverage_90 at every lead past 0: heave; roll; pitch |",
-        "|---|---|---|---|---|---|---|---|",
+        "| case | vessel | heave span (median, s) | roll span (median, s) | heave corr 30 / 60 s | roll corr 30 / 60 s | NRMSE at each span's end: heave; roll | coverage_90 inside each one's span: heave; roll; pitch | coverage_90 at every lead past 0: heave; roll; pitch |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, what, keys in CASES:
         if a.only and name not in a.only.split(","):
@@ -113,10 +116,11 @@ def main():
         j = json.load(open(os.path.join(rep, "skill.json")))
         for r in summarize(j):
             nr = r["nrmse_end"]
-            nrmse = "no span" if nr["heave"] is None else f"{nr['heave']:.2f} / {nr['roll']:.2f}"
+            nrmse = "; ".join("-" if nr[d] is None else f"{nr[d]:.2f}" for d in ("heave", "roll"))
             span_of = lambda c: "; ".join("-" if c[d] is None else f"{c[d][0]:.2f}-{c[d][1]:.2f}" for d in DOFS)
             cov = span_of(r["cov"]) + " | " + span_of(r["cov_all"])
-            lines.append(f"| {name}: {what} | {r['vessel']} | {r['span'][0]:.0f}-{r['span'][1]:.0f} | "
+            sp = lambda d: f"{r['spans'][d][0]:.0f}-{r['spans'][d][1]:.0f}"
+            lines.append(f"| {name}: {what} | {r['vessel']} | {sp('heave')} | {sp('roll')} | "
                          f"{fmt_pair(r['corr']['heave'])} | {fmt_pair(r['corr']['roll'])} | {nrmse} | {cov} |")
         print(f"{name}: {time.time() - t:.0f} s", file=sys.stderr)
     text = "\n".join(lines) + "\n"
