@@ -311,6 +311,24 @@ impl Engine {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)))
     }
 
+    /// Whether every vessel's newest motion sample is in: each vessel whose motion is not stale
+    /// (within `forecast.max_motion_age_s` of the newest of all) has one within half its own sample
+    /// interval of the newest of all (the daemon ticks on that: a forecast then starts from the newest
+    /// motion, not from one up to a sample interval older). False before any motion.
+    pub fn motion_complete(&self) -> bool {
+        let (_, hi) = self.newest_motion_s();
+        if !hi.is_finite() {
+            return false;
+        }
+        self.hist.iter().all(|h| match h.newest_time_s() {
+            Some(t) if hi - t <= self.cfg.max_motion_age_s => {
+                let rate = h.rate_hz();
+                hi - t <= if rate > 0.0 { 0.5 / rate } else { 0.0 }
+            }
+            _ => true,
+        })
+    }
+
     /// Radiation memory the engine keeps, s.
     pub fn memory_s(&self) -> f64 {
         self.taps as f64 * self.dt_s

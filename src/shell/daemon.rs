@@ -219,8 +219,11 @@ pub async fn run(
     let mut th = Threads::start(&names, Computer::new(model, &sys, &cfg), &stop)?;
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
-    let mut tick = tokio::time::interval(Duration::from_secs_f64(cfg.forecast.period_s));
-    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let period_s = cfg.forecast.period_s;
+    // the cadence follows the motion (`Cadence::due`); this timer only looks whether a tick is due
+    // without it (no motion, or the vessels' samples never together)
+    let mut look = tokio::time::interval(Duration::from_secs_f64((period_s / 4.0).min(LATE_TICK_S)));
+    look.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let start = Instant::now();
     // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
     // log times are this clock, so they line up with the ship's other logs)
@@ -230,16 +233,21 @@ pub async fn run(
     if let Some(p) = &state_path {
         warm_start(&mut engine, p, clock());
     }
-    let mut state_saved_s = clock();
-    // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
-    // decision); a write error is logged and ends the recording, never the daemon
-    let mut recorder = open_recorder(&cfg, &sys);
-    let mut failure: Option<&str> = None;
-    // the watchdog is fed while the compute thread keeps up: a job outstanding for longer than
-    // `hung_after_s` is a hung computation, and systemd restarts the service
-    let hung_after_s = hung_after_s(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6));
-    let mut outstanding: Option<Instant> = None;
-    let mut hung = false;
+    let mut c = Cadence {
+        period_s,
+        watchdog,
+        // the watchdog is fed while the compute thread keeps up: a job outstanding for longer than
+        // this is a hung computation, and systemd restarts the service
+        hung_after_s: hung_after_s(period_s, watchdog.then_some(watchdog_usec as f64 / 1e6)),
+        outstanding: None,
+        hung: false,
+        failure: None,
+        // recording: inputs, ticks and forecasts, log time = the engine's clock (replay retakes every
+        // decision); a write error is logged and ends the recording, never the daemon
+        recorder: open_recorder(&cfg, &sys),
+        state: state_path.clone().map(|p| (p, cfg.state.every_s, clock())),
+        last_tick_s: f64::NEG_INFINITY,
+    };
     tokio::pin!(shutdown);
     loop {
         tokio::select! {
@@ -247,58 +255,24 @@ pub async fn run(
             msg = th.in_rx.recv() => {
                 let Some(msg) = msg else { break };
                 let t = clock();
-                record_input(&mut recorder, t, &msg);
+                record_input(&mut c.recorder, t, &msg);
+                let motion = matches!(msg, Input::Motion(_));
                 engine.input(msg, t);
+                if motion && c.due(&engine, t) && !c.tick(&mut engine, &th, t) {
+                    break;
+                }
             }
             done = th.done_rx.recv() => {
                 let Some(d) = done else {
-                    tracing::error!("the compute thread has ended (a panic): stopping, with an error, so that systemd restarts shipcast");
-                    failure = Some("the compute thread ended unexpectedly");
+                    c.compute_ended();
                     break;
                 };
-                outstanding = None;
-                if hung {
-                    tracing::warn!("the compute thread finished its forecast at last: the watchdog is fed again");
-                    hung = false;
-                }
-                if let Some(out) = engine.done(d) {
-                    if let Output::Forecast(h, v) = &out {
-                        let rec = crate::shell::record::Record::Forecast(crate::shell::record::ForecastRecord::of(h, v));
-                        record(&mut recorder, clock(), rec);
-                    }
-                    let _ = th.out_tx.send(out);
-                }
+                c.done(&mut engine, &th, d, clock());
             }
-            _ = tick.tick() => {
-                if th.compute.is_finished() {
-                    tracing::error!("the compute thread has ended (a panic): stopping, with an error, so that systemd restarts shipcast");
-                    failure = Some("the compute thread ended unexpectedly");
-                    break;
-                }
-                let busy_s = outstanding.map_or(0.0, |o| o.elapsed().as_secs_f64());
-                if busy_s > hung_after_s && !hung {
-                    hung = true;
-                    tracing::error!(
-                        busy_s,
-                        "the compute thread has been on one forecast for more than {hung_after_s} s (hung): {}",
-                        if watchdog { "the watchdog is no longer fed, so that systemd restarts shipcast" } else { "no watchdog is set (systemd's WatchdogSec) to restart shipcast" }
-                    );
-                }
-                if watchdog && !hung {
-                    let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
-                }
+            _ = look.tick() => {
                 let t = clock();
-                record(&mut recorder, t, crate::shell::record::Record::Tick(crate::shell::record::TickRecord { clock_s: t }));
-                if let Some(job) = engine.tick(t) {
-                    let _ = th.job_tx.send(job);
-                    outstanding = Some(Instant::now());
-                }
-                let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), true)));
-                if let Some(p) = &state_path && t - state_saved_s >= cfg.state.every_s {
-                    state_saved_s = t;
-                    let (p, state) = (p.clone(), engine.state(t));
-                    // written off the loop: a few megabytes
-                    tokio::task::spawn_blocking(move || keep_state(&p, &state));
+                if c.due(&engine, t) && !c.tick(&mut engine, &th, t) {
+                    break;
                 }
             }
         }
@@ -306,18 +280,111 @@ pub async fn run(
     stop.store(true, Ordering::Relaxed);
     let _ = th.out_tx.send(Output::Status(engine.status(clock(), wall_s(), false)));
     if let Some(p) = &state_path
-        && failure.is_none()
+        && c.failure.is_none()
     {
         keep_state(p, &engine.state(clock()));
     }
-    finish(th, recorder, &engine, hung);
-    match failure {
+    finish(th, c.recorder, &engine, c.hung);
+    match c.failure {
         Some(why) => Err(why.to_string().into()),
         None => Ok(()),
     }
 }
 
-/// The compute thread is hung when a job has been outstanding this long, s: with a watchdog, its
+/// A tick waits at most this long past its period for every vessel's newest sample, s.
+const LATE_TICK_S: f64 = 0.05;
+
+/// The daemon loop's cadence and what it keeps beside the engine: the watchdog, the job outstanding,
+/// the recorder, the learnt state's file.
+struct Cadence {
+    period_s: f64,
+    watchdog: bool,
+    hung_after_s: f64,
+    outstanding: Option<Instant>,
+    hung: bool,
+    failure: Option<&'static str>,
+    recorder: Option<crate::shell::record::RotatingRecorder>,
+    /// Where the learnt state is kept, how often, and when it was last written (engine clock).
+    state: Option<(std::path::PathBuf, f64, f64)>,
+    last_tick_s: f64,
+}
+
+impl Cadence {
+    /// Whether a tick is due at `t`: a period since the last, and every vessel's newest sample in (a
+    /// forecast then starts from the newest motion, not from one up to a sample interval older), or
+    /// [`LATE_TICK_S`] later whatever came.
+    fn due(&self, engine: &Engine, t: f64) -> bool {
+        let since = t - self.last_tick_s;
+        since >= self.period_s && (engine.motion_complete() || since >= self.period_s + LATE_TICK_S)
+    }
+
+    /// One tick at `t`: the watchdog, the job, the status, the learnt state; false when the compute
+    /// thread has ended.
+    fn tick(&mut self, engine: &mut Engine, th: &Threads, t: f64) -> bool {
+        self.last_tick_s = t;
+        if th.compute.is_finished() {
+            self.compute_ended();
+            return false;
+        }
+        let busy_s = self.outstanding.map_or(0.0, |o| o.elapsed().as_secs_f64());
+        if busy_s > self.hung_after_s && !self.hung {
+            self.hung = true;
+            tracing::error!(
+                busy_s,
+                "the compute thread has been on one forecast for more than {} s (hung): {}",
+                self.hung_after_s,
+                if self.watchdog {
+                    "the watchdog is no longer fed, so that systemd restarts shipcast"
+                } else {
+                    "no watchdog is set (systemd's WatchdogSec) to restart shipcast"
+                }
+            );
+        }
+        if self.watchdog && !self.hung {
+            let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Watchdog]);
+        }
+        let rec = crate::shell::record::Record::Tick(crate::shell::record::TickRecord { clock_s: t });
+        record(&mut self.recorder, t, rec);
+        if let Some(job) = engine.tick(t) {
+            let _ = th.job_tx.send(job);
+            self.outstanding = Some(Instant::now());
+        }
+        let _ = th.out_tx.send(Output::Status(engine.status(t, wall_s(), true)));
+        if let Some((p, every_s, saved_s)) = &mut self.state
+            && t - *saved_s >= *every_s
+        {
+            *saved_s = t;
+            let (p, state) = (p.clone(), engine.state(t));
+            // written off the loop: a few megabytes
+            tokio::task::spawn_blocking(move || keep_state(&p, &state));
+        }
+        true
+    }
+
+    /// A finished job: published (and recorded), the watchdog fed again.
+    fn done(&mut self, engine: &mut Engine, th: &Threads, d: Done, t: f64) {
+        self.outstanding = None;
+        if self.hung {
+            tracing::warn!("the compute thread finished its forecast at last: the watchdog is fed again");
+            self.hung = false;
+        }
+        if let Some(out) = engine.done(d) {
+            if let Output::Forecast(h, v) = &out {
+                let rec = crate::shell::record::Record::Forecast(crate::shell::record::ForecastRecord::of(h, v));
+                record(&mut self.recorder, t, rec);
+            }
+            let _ = th.out_tx.send(out);
+        }
+    }
+
+    fn compute_ended(&mut self) {
+        tracing::error!(
+            "the compute thread has ended (a panic): stopping, with an error, so that systemd restarts shipcast"
+        );
+        self.failure = Some("the compute thread ended unexpectedly");
+    }
+}
+
 /// Takes the learnt state kept at `path` into the engine, or says why not (the daemon then starts
 /// cold).
 fn warm_start(engine: &mut Engine, path: &std::path::Path, clock_s: f64) {
@@ -343,6 +410,7 @@ fn keep_state(path: &std::path::Path, state: &crate::engine::state::EngineState)
     }
 }
 
+/// The compute thread is hung when a job has been outstanding this long, s: with a watchdog, its
 /// interval less two periods (the last ping before it then lands inside the interval, and systemd acts
 /// one interval later), at least half of it; without, 30 s (said, nothing else acts on it).
 fn hung_after_s(period_s: f64, watchdog_s: Option<f64>) -> f64 {
