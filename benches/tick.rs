@@ -26,7 +26,13 @@ fn benches(c: &mut Criterion) {
     std::fs::create_dir_all(&dir).unwrap();
     let log = dir.join("demo.mcap");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_shipcast"))
-        .args(["simulate", "--config", config.to_str().unwrap(), "--record", log.to_str().unwrap()])
+        .args([
+            "simulate",
+            "--config",
+            config.to_str().unwrap(),
+            "--record",
+            log.to_str().unwrap(),
+        ])
         .args(["--duration", &HISTORY_S.to_string()])
         .status()
         .expect("shipcast simulate");

@@ -179,3 +179,26 @@ fn roll_tuning_finds_quadratic_damping() {
         "tuned {t:?}, truth {truth_tuning:?} ({r:?})"
     );
 }
+
+/// A tuning kept across a restart of the daemon is the tuning in force again: the tuner resumed
+/// from it reports it, and the model it makes is the model as built with it.
+#[test]
+fn a_kept_roll_tuning_is_taken_back() {
+    let (_, model) = ship();
+    let kept = RollTuning {
+        damping_fraction: 0.04,
+        quadratic_fraction: 0.02,
+        frequency_correction: 0.03,
+    };
+    let mut tuner = Tuner::new(&model).unwrap();
+    let vessel = roll_rows(&model)[0].vessel;
+    let mut by_vessel = vec![[0.0; 3]; vessel + 1];
+    by_vessel[vessel] = kept.as_array();
+    tuner.resume(&by_vessel);
+    assert_eq!(tuner.tuning(), vec![(vessel, kept)]);
+    let resumed = tuner.apply(&model).unwrap();
+    let direct = model.adjusted(&changes(&roll_rows(&model), &[kept])).unwrap();
+    assert_eq!(resumed.damping, direct.damping);
+    assert_eq!(resumed.stiffness, direct.stiffness);
+    assert_ne!(resumed.damping, model.damping, "the tuning changes the model");
+}

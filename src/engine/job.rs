@@ -392,6 +392,16 @@ fn untrusted(mut s: band::Spread) -> band::Spread {
 }
 
 impl Computer {
+    /// Starts the in-situ roll tuning from the tuning kept across a restart (per vessel: damping,
+    /// quadratic, frequency; `Engine::roll_tuning` after `Engine::restore`).
+    pub fn resume_tuning(&mut self, kept: &[[f64; 3]]) {
+        if let Some(model) = self.tuning.resume(&self.base, kept) {
+            self.table = response_table(&model);
+            self.coupling = vec![None; self.n_bodies];
+            self.model = model;
+        }
+    }
+
     /// One step of the in-situ roll tuning (a round's next candidate), run between jobs so that it
     /// does not delay a forecast; a finished round's tuning becomes the model forecasts run with.
     pub fn tune(&mut self) {

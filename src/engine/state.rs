@@ -1,7 +1,8 @@
 //! What the engine keeps across a restart of the daemon (pure): each vessel's motion history and what
 //! its estimator learnt (bias, drift, the hindsight checks), the sources' clocks, the navigation
 //! fixes, the model error learnt from past forecasts (and the forecasts still to be checked), the
-//! model's own mean in waves and the heel (not yet the in-situ roll tuning, which starts again). Kept
+//! model's own mean in waves, the heel, and the in-situ roll tuning in force (the computer takes it
+//! back: `Computer::resume_tuning`). Kept
 //! with a fingerprint of the system and settings they were learnt on, and the engine clock then:
 //! [`Engine::restore`] refuses a state of another version, another system or settings, or older than
 //! the radiation memory the engine keeps (its history would say nothing of the motion now).
@@ -15,7 +16,7 @@ use super::navigation::NavTrack;
 use super::*;
 
 /// The state's layout; a state of another version is refused.
-pub const STATE_VERSION: u32 = 1;
+pub const STATE_VERSION: u32 = 2;
 
 /// The engine's learnt state ([`Engine::state`], [`Engine::restore`]).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -35,6 +36,7 @@ pub struct EngineState {
     model_mean_time_s: Option<f64>,
     heel_square: Vec<RunningMean>,
     heel_time_s: Option<f64>,
+    roll_tuning: [[f64; 3]; MAX_VESSELS],
 }
 
 /// Why a kept state was not taken.
@@ -104,6 +106,7 @@ impl Engine {
             model_mean_time_s: self.model_mean_time_s,
             heel_square: self.heel_square.clone(),
             heel_time_s: self.heel_time_s,
+            roll_tuning: self.roll_tuning,
         }
     }
 
@@ -142,6 +145,7 @@ impl Engine {
         self.model_mean_time_s = s.model_mean_time_s;
         self.heel_square = s.heel_square;
         self.heel_time_s = s.heel_time_s;
+        self.roll_tuning = s.roll_tuning;
         Ok(())
     }
 }

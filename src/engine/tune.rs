@@ -63,6 +63,17 @@ impl Tuning {
         }
     }
 
+    /// Starts from a tuning kept across a restart ([`Tuner::resume`]): the model as built, `base`,
+    /// with it (None: no tuning, or the model could not be made).
+    pub fn resume(&mut self, base: &TimeModel, kept: &[[f64; 3]]) -> Option<TimeModel> {
+        let tuner = self.tuner.as_mut()?;
+        tuner.resume(kept);
+        tuner
+            .apply(base)
+            .map_err(|e| tracing::warn!("the kept roll tuning could not be applied, the model as built kept: {e}"))
+            .ok()
+    }
+
     /// Takes a job's trace (at start time `t0_s`) and, when it may be one, its start as a case; hands
     /// on the report of a round finished since the last job.
     pub fn take(&mut self, t0_s: f64, input: Option<&TuneInput>, case: impl FnOnce() -> Case) -> Option<TunerReport> {
@@ -126,6 +137,11 @@ impl Engine {
             trace: Arc::new(self.trace.iter().cloned().collect()),
             case: eligible && fl & NOT_A_CASE == 0,
         })
+    }
+
+    /// The roll tuning in force per vessel (damping, quadratic, frequency; the status's).
+    pub fn roll_tuning(&self) -> &[[f64; 3]] {
+        &self.roll_tuning[..self.n_bodies.min(MAX_VESSELS)]
     }
 
     /// A finished tuning round: logged, and its figures kept for the status.

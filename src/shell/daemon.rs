@@ -216,7 +216,19 @@ pub async fn run(
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
     };
-    let mut th = Threads::start(&names, Computer::new(model, &sys, &cfg), &stop)?;
+    let start = Instant::now();
+    // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
+    // log times are this clock, so they line up with the ship's other logs)
+    let clock_anchor_s = wall_s();
+    let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
+    let mut computer = Computer::new(model, &sys, &cfg);
+    let state_path = crate::shell::state::path(&cfg);
+    if let Some(p) = &state_path
+        && warm_start(&mut engine, p, clock())
+    {
+        computer.resume_tuning(engine.roll_tuning());
+    }
+    let mut th = Threads::start(&names, computer, &stop)?;
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let period_s = cfg.forecast.period_s;
@@ -224,15 +236,6 @@ pub async fn run(
     // without it (no motion, or the vessels' samples never together)
     let mut look = tokio::time::interval(Duration::from_secs_f64((period_s / 4.0).min(LATE_TICK_S)));
     look.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
-    let start = Instant::now();
-    // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
-    // log times are this clock, so they line up with the ship's other logs)
-    let clock_anchor_s = wall_s();
-    let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
-    let state_path = crate::shell::state::path(&cfg);
-    if let Some(p) = &state_path {
-        warm_start(&mut engine, p, clock());
-    }
     let mut c = Cadence {
         period_s,
         watchdog,
@@ -386,21 +389,23 @@ impl Cadence {
 }
 
 /// Takes the learnt state kept at `path` into the engine, or says why not (the daemon then starts
-/// cold).
-fn warm_start(engine: &mut Engine, path: &std::path::Path, clock_s: f64) {
+/// cold); whether it was taken.
+fn warm_start(engine: &mut Engine, path: &std::path::Path, clock_s: f64) -> bool {
     match crate::shell::state::read(path) {
         Ok(None) => tracing::info!(path = %path.display(), "no state kept: a cold start"),
         Ok(Some(s)) => {
             let age_s = clock_s - s.clock_s;
             match engine.restore(s, clock_s) {
                 Ok(()) => {
-                    tracing::info!(path = %path.display(), age_s, "warm start: the learnt state kept {age_s:.1} s ago taken back")
+                    tracing::info!(path = %path.display(), age_s, "warm start: the learnt state kept {age_s:.1} s ago taken back");
+                    return true;
                 }
                 Err(why) => tracing::warn!(path = %path.display(), "{why}: refused, a cold start"),
             }
         }
         Err(e) => tracing::warn!("{e}: refused, a cold start"),
     }
+    false
 }
 
 /// Writes the learnt state, logging a failure (the daemon goes on).

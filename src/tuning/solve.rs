@@ -140,6 +140,18 @@ impl Tuner {
             .collect()
     }
 
+    /// Starts from a tuning kept across a restart of the daemon (damping, quadratic, frequency per
+    /// vessel, by the vessel's index): the tuning in force and the rounds' centre. Vessels it does not
+    /// tune, and values that are not finite, are passed over.
+    pub fn resume(&mut self, kept: &[[f64; 3]]) {
+        for (k, r) in self.rows.iter().enumerate() {
+            if let Some(p) = kept.get(r.vessel).filter(|p| p.iter().all(|v| v.is_finite())) {
+                self.center[3 * k..3 * k + 3].copy_from_slice(p);
+                self.smoothed[3 * k..3 * k + 3].copy_from_slice(p);
+            }
+        }
+    }
+
     /// The model as built with the tuning now.
     pub fn apply(&self, base: &TimeModel) -> crate::rom::Result<TimeModel> {
         base.adjusted(&changes(&self.rows, &params(&self.smoothed)))

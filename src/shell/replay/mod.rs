@@ -41,10 +41,11 @@ pub fn drive_from(
     crate::engine::fits_the_wire(sys)?;
     let model = crate::rom::TimeModel::new(sys, rom_options(cfg, sys))?;
     let mut engine = Engine::new(cfg, sys, &model);
+    let mut computer = Computer::new(model, sys, cfg);
     if let (Some(s), Some((t, _))) = (state, records.first()) {
         engine.restore(s, *t).map_err(|why| Error::from(why.to_string()))?;
+        computer.resume_tuning(engine.roll_tuning());
     }
-    let mut computer = Computer::new(model, sys, cfg);
     let period = cfg.forecast.period_s;
     // ticks on the grid t0 + k period; past this long after the last input no tick can issue a forecast
     // (the motion is stale), so a gap in the log is crossed in one step, not a tick per period
