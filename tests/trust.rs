@@ -803,6 +803,22 @@ fn heave_band_growth(run: &Run, t0: f64, from_s: f64) -> f64 {
 /// checks it missed while refusing and their noise, not the fault's size.
 const BAND_GROWTH_AFTER_FAULT: f64 = 1.25;
 
+/// `records` (a motion fault from [`FAULT_AT_S`]) driven: forecasts go on, none trusted with a start
+/// off the truth, and the band learnt no more than [`BAND_GROWTH_AFTER_FAULT`] of the fault.
+fn never_trusted_off_nor_learnt(records: &[(f64, Record)], fault: &str) -> Run {
+    let run = drive(records);
+    invariants(&run);
+    forecasts_go_on(records, &run, fault);
+    let wrong = trusted_off_the_truth(&run, records, FAULT_AT_S - 1.0);
+    assert!(wrong.is_empty(), "{fault}: {}", wrong.join("\n"));
+    let growth = heave_band_growth(&run, start(records), FAULT_AT_S);
+    assert!(
+        growth < BAND_GROWTH_AFTER_FAULT,
+        "{fault}: the heave band at 30 s grew {growth:.2} times"
+    );
+    run
+}
+
 /// Was: five +50 m heave spikes in 0.5 s, the fifth just before a forecast, restarted the estimate
 /// from them: that forecast was published starting at 50 m with only `history_short`, the next good
 /// samples restarted it again, and the model error learnt from both (the band at 30 s grew many
@@ -830,16 +846,7 @@ fn a_burst_of_spikes_is_never_published_trusted_nor_learnt_from() {
             m.x[2] += SPIKE_M;
         }
     }
-    let run = drive(&records);
-    invariants(&run);
-    forecasts_go_on(&records, &run, "the burst");
-    let wrong = trusted_off_the_truth(&run, &records, FAULT_AT_S - 1.0);
-    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
-    let growth = heave_band_growth(&run, t0, FAULT_AT_S);
-    assert!(
-        growth < BAND_GROWTH_AFTER_FAULT,
-        "the heave band at 30 s grew {growth:.2} times"
-    );
+    let run = never_trusted_off_nor_learnt(&records, "the burst");
     // the burst is gone as soon as the motion leaves it: forecasts are trusted again within seconds
     let back = after(&run, t0, FAULT_AT_S + 10.0);
     assert!(
@@ -865,16 +872,7 @@ fn a_sensor_re_zeroed_is_not_trusted_until_its_new_offset_is_known() {
             m.x[2] += OFFSET_M;
         }
     }
-    let run = drive(&records);
-    invariants(&run);
-    forecasts_go_on(&records, &run, "the offset");
-    let wrong = trusted_off_the_truth(&run, &records, FAULT_AT_S - 1.0);
-    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
-    let growth = heave_band_growth(&run, t0, FAULT_AT_S);
-    assert!(
-        growth < BAND_GROWTH_AFTER_FAULT,
-        "the heave band at 30 s grew {growth:.2} times"
-    );
+    let run = never_trusted_off_nor_learnt(&records, "the offset");
     assert!(
         run.statuses.iter().any(|s| s.flags & flags::MOTION_SETTLING != 0),
         "the status says the estimate is settling"

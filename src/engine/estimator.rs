@@ -510,16 +510,9 @@ impl Estimator {
 
     /// Takes back what [`Estimator::state`] kept (samples older than the kept window go).
     pub fn restore(&mut self, s: EstimatorState) {
-        let l = s.learnt;
-        self.entries = l.entries;
-        self.bias = l.bias;
-        self.innovation = l.innovation;
-        self.checks = l.checks;
-        self.next_check_s = l.next_check_s;
+        self.put_learnt(s.learnt);
         self.learned = s.learned;
         self.moved = s.moved;
-        self.candidate.clear();
-        self.jump = None;
         if let Some(t) = self.newest_time_s() {
             while self.entries.front().is_some_and(|f| t - f.time_s > self.keep_s) && self.entries.len() > 2 {
                 self.entries.pop_front();
@@ -897,16 +890,21 @@ impl Estimator {
             }
             return false;
         };
-        let b = *before;
-        self.entries = b.entries;
-        self.bias = b.bias;
-        self.innovation = b.innovation;
-        self.checks = b.checks;
-        self.next_check_s = b.next_check_s;
-        self.candidate.clear();
-        self.jump = None;
+        self.put_learnt(*before);
         self.take(e);
         true
+    }
+
+    /// Puts `l` in place of what the estimate has learnt, with no run of refused samples and no
+    /// restart settling (a revert, a restore).
+    fn put_learnt(&mut self, l: Learnt) {
+        self.entries = l.entries;
+        self.bias = l.bias;
+        self.innovation = l.innovation;
+        self.checks = l.checks;
+        self.next_check_s = l.next_check_s;
+        self.candidate.clear();
+        self.jump = None;
     }
 
     /// A sample refused by the gate: kept as a candidate jump; `reset_samples` in a row that agree
