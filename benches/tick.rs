@@ -67,7 +67,7 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             let job = engine.tick(end_s).expect("a job");
             let done = computer.run(job, || 0.0);
-            engine.done(done).is_some()
+            engine.done(done, end_s).is_some()
         })
     });
     g.finish();

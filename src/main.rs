@@ -70,12 +70,15 @@ enum DbCommand {
     },
 }
 
-/// Logs to stderr: `RUST_LOG` if set, else `level`; human-readable or JSON lines.
+/// Logs to stderr: `RUST_LOG` if set, else `level`; human-readable or JSON lines. At debug level the
+/// daemon's spans say where each forecast's time went (`RUST_LOG=info,shipcast=debug`).
 fn init_logging(level: &str, json: bool) {
     // iceoryx2 logs through tracing; its warnings (e.g. "no config file, defaults used") are noise here
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| format!("{level},iceoryx2_bb_loggers=error").into());
+    // the daemon's debug spans (input, tick, forecast, band, publish) log their busy time on close
     let b = tracing_subscriber::fmt()
+        .with_span_events(tracing_subscriber::fmt::format::FmtSpan::CLOSE)
         .with_env_filter(filter)
         .with_writer(std::io::stderr);
     if json {

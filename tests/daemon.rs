@@ -903,11 +903,13 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
     eprintln!(
         "a forecast trusted {cold_s:.1} s after the first start, {warm_s:?} s after the restart (wall; data at 4 x; the killed daemon's last forecast at {last_s:.1} s)"
     );
+    back.kill();
+    let mut back_log = String::new();
+    back.0.stderr.take().unwrap().read_to_string(&mut back_log).unwrap();
     assert!(
         warm_s.is_some_and(|w| w <= 15.0 && w < cold_s),
-        "warm {warm_s:?}, cold {cold_s}"
+        "warm {warm_s:?}, cold {cold_s}; the restarted daemon's log:\n{back_log}"
     );
-    back.kill();
     // a corrupt state: refused, named, a cold start
     std::fs::write(&path, b"shipcast state\n\x07\x07\x07").unwrap();
     let mut corrupt = spawn(&["run", "--config", cfg.to_str().unwrap()]);

@@ -616,6 +616,17 @@ pub fn status_json(s: &Status, n_vessels: usize) -> String {
         "motion_rate_hz": list(&s.motion_rate_hz),
         "last_forecast_time_s": finite(s.last_forecast_time_s),
         "last_compute_ms": finite(s.last_compute_ms),
+        // where the last forecast's time went, and the quantiles of the total over the newest
+        // forecasts (src/engine/latency.rs)
+        "latency": serde_json::json!({
+            "stages_ms": shipcast::engine::latency::STAGE_NAMES
+                .iter()
+                .zip(s.latency_ms)
+                .map(|(n, v)| (n.to_string(), finite(v)))
+                .collect::<serde_json::Map<_, _>>(),
+            "p50_ms": finite(s.latency_p50_ms).as_f64().filter(|v| *v >= 0.0),
+            "p99_ms": finite(s.latency_p99_ms).as_f64().filter(|v| *v >= 0.0),
+        }),
         "horizon_s": list(&s.horizon_s),
         "forecasts": s.forecasts,
         "overruns": s.overruns,

@@ -48,6 +48,8 @@ pub struct Done {
     pub header: ForecastHeader,
     pub values: Option<Vec<f64>>,
     pub compute_ms: f64,
+    /// The compute thread's stages ([`super::latency`]); `build_ms` and `queued_ms` are the shell's to set.
+    pub times: super::latency::ComputeTimes,
     pub error: Option<String>,
     /// Share of the wave variance the forecast left out (outside the database), 0..1.
     pub dropped_wave_share: f64,
@@ -196,11 +198,25 @@ impl Computer {
             waves: job.waves.clone(),
             track: job.track,
         });
-        let result = self.forecast(&job).map(|(values, steps, dropped, quasi_static)| {
+        let t_start_ms = elapsed_ms();
+        let mut t_forecast_ms = t_start_ms;
+        let result = {
+            let _span = tracing::debug_span!("forecast", t0_s = job.t0_s).entered();
+            self.forecast(&job)
+        }
+        .map(|(values, steps, dropped, quasi_static)| {
+            t_forecast_ms = elapsed_ms();
+            let _span = tracing::debug_span!("band", t0_s = job.t0_s).entered();
             let spread = self.band(&job, steps);
             (values, steps, dropped, quasi_static, spread)
         });
         let compute_ms = elapsed_ms();
+        let times = super::latency::ComputeTimes {
+            build_ms: 0.0,
+            queued_ms: 0.0,
+            forecast_ms: t_forecast_ms,
+            band_ms: compute_ms - t_forecast_ms,
+        };
         let mut header = job.header;
         header.compute_ms = compute_ms;
         header.issue_time_s = job.t0_s;
@@ -243,6 +259,7 @@ impl Computer {
                     header,
                     values: Some(values),
                     compute_ms,
+                    times,
                     error: None,
                     dropped_wave_share,
                     teaches: job.trustworthy && !motion_sigma.is_empty() && !mismatch,
@@ -257,6 +274,7 @@ impl Computer {
                 header,
                 values: None,
                 compute_ms,
+                times,
                 error: Some(e.to_string()),
                 dropped_wave_share: 0.0,
                 motion_sigma: vec![],

@@ -18,7 +18,7 @@ pub const WAVES_SCHEMA_VERSION: u32 = 2;
 pub const FORECAST_SCHEMA_VERSION: u32 = 3;
 /// Schema version of [`Status`] (2: the drop counters by reason and the clock steps; 3: the motion
 /// estimator's refusals, restarts and bias).
-pub const STATUS_SCHEMA_VERSION: u32 = 5;
+pub const STATUS_SCHEMA_VERSION: u32 = 6;
 /// Vessels a forecast or status can describe.
 pub const MAX_VESSELS: usize = 4;
 /// The most components a wave field may carry: the wavenumber bins of a 256 x 256 radar grid. A field
@@ -228,7 +228,7 @@ pub struct ForecastHeader {
     pub series_trusted_from_s: [f64; 6 * MAX_VESSELS],
 }
 
-/// Health of the daemon, published every cycle. 488 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
+/// Health of the daemon, published every cycle. 560 bytes; `schema_version` = [`STATUS_SCHEMA_VERSION`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 pub struct Status {
@@ -293,6 +293,14 @@ pub struct Status {
     /// 1 once the roll tuning has converged (its last rounds moved no parameter), else 0.
     pub roll_tuning_converged: u32,
     pub reserved: u32,
+    /// Where the last forecast's time went, ms, from the newest motion sample's stamp to its
+    /// hand-over for publishing, by stage ([`crate::engine::latency::STAGE_NAMES`]: received, waited,
+    /// built, queued, forecast, band, handed); zeros before the first.
+    pub latency_ms: [f64; 7],
+    /// The median and the 99th percentile of that total over the newest
+    /// [`crate::engine::latency::LATENCY_WINDOW`] forecasts, ms (-1: none yet).
+    pub latency_p50_ms: f64,
+    pub latency_p99_ms: f64,
 }
 
 /// The link's state (`link_state` of [`Status`]).
@@ -594,7 +602,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<MotionSample>(), 112);
         assert_eq!(std::mem::size_of::<NavigationSample>(), 80);
         assert_eq!(std::mem::size_of::<ForecastHeader>(), 512);
-        assert_eq!(std::mem::size_of::<Status>(), 488);
+        assert_eq!(std::mem::size_of::<Status>(), 560);
         assert_eq!(std::mem::size_of::<LinkStatus>(), 64);
     }
 }

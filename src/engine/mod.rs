@@ -15,6 +15,7 @@ pub mod navigation;
 
 mod input;
 mod job;
+pub mod latency;
 mod publish;
 mod setup;
 pub mod state;
@@ -154,6 +155,9 @@ pub struct Engine {
     busy: bool,
     last_forecast_time: f64,
     last_compute_ms: f64,
+    /// Where the forecasts' time goes ([`latency`]), and where the running job's started.
+    latency: latency::Latency,
+    job_start: Option<latency::JobStart>,
     last_horizon: [f64; MAX_VESSELS],
     /// The newest wave field or radar scan repeated the one before at a later stamp (refused: a frozen
     /// processor).
@@ -255,6 +259,8 @@ impl Engine {
             busy: false,
             last_forecast_time: -1.0,
             last_compute_ms: 0.0,
+            latency: latency::Latency::default(),
+            job_start: None,
             last_horizon: [0.0; MAX_VESSELS],
             link: None,
             waves_frozen: false,
@@ -311,22 +317,32 @@ impl Engine {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)))
     }
 
-    /// Whether every vessel's newest motion sample is in: each vessel whose motion is not stale
+    /// When every vessel's newest motion sample is in, the newest stamp of all and half the longest
+    /// sample interval (the stamps' own jitter allowance): each vessel whose motion is not stale
     /// (within `forecast.max_motion_age_s` of the newest of all) has one within half its own sample
     /// interval of the newest of all (the daemon ticks on that: a forecast then starts from the newest
-    /// motion, not from one up to a sample interval older). False before any motion.
-    pub fn motion_complete(&self) -> bool {
+    /// motion, not from one up to a sample interval older). None before any motion, or while a
+    /// vessel's sample is still to come.
+    pub fn motion_complete(&self) -> Option<(f64, f64)> {
         let (_, hi) = self.newest_motion_s();
         if !hi.is_finite() {
-            return false;
+            return None;
         }
-        self.hist.iter().all(|h| match h.newest_time_s() {
-            Some(t) if hi - t <= self.cfg.max_motion_age_s => {
-                let rate = h.rate_hz();
-                hi - t <= if rate > 0.0 { 0.5 / rate } else { 0.0 }
+        let mut half_interval_s = 0.0f64;
+        for h in &self.hist {
+            match h.newest_time_s() {
+                Some(t) if hi - t <= self.cfg.max_motion_age_s => {
+                    let rate = h.rate_hz();
+                    let half = if rate > 0.0 { 0.5 / rate } else { 0.0 };
+                    if hi - t > half {
+                        return None;
+                    }
+                    half_interval_s = half_interval_s.max(half);
+                }
+                _ => {}
             }
-            _ => true,
-        })
+        }
+        Some((hi, half_interval_s))
     }
 
     /// Radiation memory the engine keeps, s.

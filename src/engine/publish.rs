@@ -4,10 +4,24 @@ use super::message::{ForecastHeader, Output, Status, flags, link_state};
 use super::*;
 
 impl Engine {
-    /// A finished job: the forecast to publish, if it succeeded.
-    pub fn done(&mut self, d: Done) -> Option<Output> {
+    /// A finished job, handed back at `clock_s`: the forecast to publish, if it succeeded.
+    pub fn done(&mut self, d: Done, clock_s: f64) -> Option<Output> {
         self.busy = false;
         self.last_compute_ms = d.compute_ms;
+        if let Some(start) = self.job_start.take() {
+            let stages = self.latency.record(start, d.times, clock_s);
+            tracing::debug!(
+                t0_s = start.stamp_s,
+                ?stages,
+                "forecast's latency, ms: {}",
+                latency::STAGE_NAMES
+                    .iter()
+                    .zip(stages)
+                    .map(|(n, v)| format!("{n} {v:.1}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
         if let Some(r) = &d.tuning {
             self.tuned(r);
         }
@@ -162,6 +176,9 @@ impl Engine {
             },
             last_forecast_time_s: self.last_forecast_time,
             last_compute_ms: self.last_compute_ms,
+            latency_ms: self.latency.last(),
+            latency_p50_ms: self.latency.total_quantile_ms(0.5),
+            latency_p99_ms: self.latency.total_quantile_ms(0.99),
             horizon_s: self.last_horizon,
             forecasts: c.forecasts,
             overruns: c.overruns,

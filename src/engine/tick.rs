@@ -72,6 +72,14 @@ impl Engine {
                 }
                 fl = header.flags;
                 self.busy = true;
+                self.job_start = Some(latency::JobStart {
+                    stamp_s: t0,
+                    arrival_s: (0..self.n_bodies)
+                        .filter(|b| motion_fresh[*b])
+                        .filter_map(|b| self.arrival[b])
+                        .fold(f64::NEG_INFINITY, f64::max),
+                    tick_s: clock_s,
+                });
                 self.job_offset = start.offset;
                 self.job_unknown = motion_fresh.iter().map(|f| !f).collect();
                 self.job_withdrawn = self.withdrawn();

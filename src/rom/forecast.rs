@@ -320,7 +320,11 @@ impl Forecaster {
                 "forecast length {length_s} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}"
             )));
         }
-        self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
+        {
+            let _span = tracing::trace_span!("wave_force", components = req.waves.len()).entered();
+            self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
+        }
+        let _span = tracing::trace_span!("steps", steps).entered();
         self.run(model, req, steps)
     }
 
@@ -354,6 +358,7 @@ impl Forecaster {
         if let (Kernel::Convolution { .. }, Memory::Convolution { len, .. }) = (&model.kernel, req.memory)
             && (*len > 0 || req.v0.iter().any(|v| *v != 0.0))
         {
+            let _span = tracing::trace_span!("history_part").entered();
             self.history_part(model, req.v0, req.memory, steps)?;
         }
         self.f0.clear();

@@ -35,14 +35,14 @@ pub use crate::shell::config::FAULT_ENV;
 
 fn compute_thread(
     mut computer: Computer,
-    jobs: std::sync::mpsc::Receiver<Job>,
+    jobs: std::sync::mpsc::Receiver<(Job, Instant)>,
     done: tokio::sync::mpsc::Sender<Done>,
     fault: Option<String>,
 ) -> std::thread::JoinHandle<()> {
     std::thread::Builder::new()
         .name("shipcast-compute".into())
         .spawn(move || {
-            while let Ok(job) = jobs.recv() {
+            while let Ok((job, sent)) = jobs.recv() {
                 match fault.as_deref() {
                     Some("compute-panic") => {
                         panic!("{FAULT_ENV}=compute-panic: the compute thread panics on its first job")
@@ -54,7 +54,8 @@ fn compute_thread(
                     _ => {}
                 }
                 let t = Instant::now();
-                let msg = computer.run(job, || t.elapsed().as_secs_f64() * 1e3);
+                let mut msg = computer.run(job, || t.elapsed().as_secs_f64() * 1e3);
+                msg.times.queued_ms = t.duration_since(sent).as_secs_f64() * 1e3;
                 if done.blocking_send(msg).is_err() {
                     break;
                 }
@@ -146,9 +147,9 @@ fn record_input(recorder: &mut Option<crate::shell::record::RotatingRecorder>, t
 
 /// The daemon's iceoryx2 threads and its compute thread, started and ready, and the channels to them.
 struct Threads {
-    in_rx: tokio::sync::mpsc::Receiver<Input>,
+    in_rx: tokio::sync::mpsc::Receiver<ipc::Arrived>,
     out_tx: std::sync::mpsc::Sender<Output>,
-    job_tx: std::sync::mpsc::Sender<Job>,
+    job_tx: std::sync::mpsc::Sender<(Job, Instant)>,
     done_rx: tokio::sync::mpsc::Receiver<Done>,
     input: std::thread::JoinHandle<()>,
     output: std::thread::JoinHandle<()>,
@@ -157,18 +158,23 @@ struct Threads {
 
 impl Threads {
     /// Starts the input and output threads (waiting until both are ready) and the compute thread.
-    fn start(names: &Names, computer: Computer, stop: &Arc<AtomicBool>) -> Result<Threads, Error> {
-        let (in_tx, in_rx) = tokio::sync::mpsc::channel::<Input>(8192);
+    fn start(
+        names: &Names,
+        computer: Computer,
+        stop: &Arc<AtomicBool>,
+        clock: impl Fn() -> f64 + Send + 'static,
+    ) -> Result<Threads, Error> {
+        let (in_tx, in_rx) = tokio::sync::mpsc::channel::<ipc::Arrived>(8192);
         let (out_tx, out_rx) = std::sync::mpsc::channel::<Output>();
         let (ready_tx, ready_rx) = std::sync::mpsc::channel();
-        let input = ipc::spawn_input(names.clone(), in_tx, stop.clone(), ready_tx.clone());
+        let input = ipc::spawn_input(names.clone(), in_tx, clock, stop.clone(), ready_tx.clone());
         let output = ipc::spawn_output(names.clone(), out_rx, ready_tx);
         for _ in 0..2 {
             ready_rx
                 .recv()
                 .map_err(|_| "an iceoryx2 thread ended before it was ready")??;
         }
-        let (job_tx, job_rx) = std::sync::mpsc::channel::<Job>();
+        let (job_tx, job_rx) = std::sync::mpsc::channel::<(Job, Instant)>();
         let (done_tx, done_rx) = tokio::sync::mpsc::channel::<Done>(4);
         let compute = compute_thread(computer, job_rx, done_tx, std::env::var(FAULT_ENV).ok());
         Ok(Threads {
@@ -220,7 +226,7 @@ pub async fn run(
     // the engine's clock: monotonic, in UNIX seconds from the wall clock at the start (a recording's
     // log times are this clock, so they line up with the ship's other logs)
     let clock_anchor_s = wall_s();
-    let clock = || clock_anchor_s + start.elapsed().as_secs_f64();
+    let clock = move || clock_anchor_s + start.elapsed().as_secs_f64();
     let mut computer = Computer::new(model, &sys, &cfg);
     let state_path = crate::shell::state::path(&cfg);
     if let Some(p) = &state_path
@@ -228,7 +234,7 @@ pub async fn run(
     {
         computer.resume_tuning(engine.roll_tuning());
     }
-    let mut th = Threads::start(&names, computer, &stop)?;
+    let mut th = Threads::start(&names, computer, &stop, clock)?;
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
     tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
     let period_s = cfg.forecast.period_s;
@@ -250,18 +256,24 @@ pub async fn run(
         recorder: open_recorder(&cfg, &sys),
         state: state_path.clone().map(|p| (p, cfg.state.every_s, clock())),
         last_tick_s: f64::NEG_INFINITY,
+        last_stamp_s: f64::NEG_INFINITY,
+        build_ms: 0.0,
     };
     tokio::pin!(shutdown);
     loop {
         tokio::select! {
             _ = &mut shutdown => break,
             msg = th.in_rx.recv() => {
-                let Some(msg) = msg else { break };
-                let t = clock();
+                // the input's arrival (the input thread's clock), not when the loop came to it
+                let Some((msg, t)) = msg else { break };
                 record_input(&mut c.recorder, t, &msg);
                 let motion = matches!(msg, Input::Motion(_));
-                engine.input(msg, t);
-                if motion && c.due(&engine, t) && !c.tick(&mut engine, &th, t) {
+                {
+                    let _span = tracing::debug_span!("input", motion).entered();
+                    engine.input(msg, t);
+                }
+                let now = clock();
+                if motion && c.due(&engine, now) && !c.tick(&mut engine, &th, now) {
                     break;
                 }
             }
@@ -297,6 +309,10 @@ pub async fn run(
 /// A tick waits at most this long past its period for every vessel's newest sample, s.
 const LATE_TICK_S: f64 = 0.05;
 
+/// How much earlier than the last a sample may arrive after its stamp and still start its tick, s (the
+/// received stage's p99 is about 1 ms: `tools/latency/measure.py`).
+const ARRIVAL_JITTER_S: f64 = 0.01;
+
 /// The daemon loop's cadence and what it keeps beside the engine: the watchdog, the job outstanding,
 /// the recorder, the learnt state's file.
 struct Cadence {
@@ -310,21 +326,32 @@ struct Cadence {
     /// Where the learnt state is kept, how often, and when it was last written (engine clock).
     state: Option<(std::path::PathBuf, f64, f64)>,
     last_tick_s: f64,
+    /// The newest motion stamp at the last tick, when every vessel's was in (data clock).
+    last_stamp_s: f64,
+    /// How long the outstanding job took to make on the loop, ms.
+    build_ms: f64,
 }
 
 impl Cadence {
-    /// Whether a tick is due at `t`: a period since the last, and every vessel's newest sample in (a
-    /// forecast then starts from the newest motion, not from one up to a sample interval older), or
-    /// [`LATE_TICK_S`] later whatever came.
+    /// Whether a tick is due at `t`: every vessel's newest sample in, stamped a period (less the
+    /// stamps' jitter allowance) after the last tick's newest, and as long (less [`ARRIVAL_JITTER_S`])
+    /// since the last tick on the loop's clock; or, whatever came, [`LATE_TICK_S`] past a period on the loop's clock. On the data's clock, a tick comes with
+    /// the sample that completes it, and the cadence keeps the sensors' phase rather than drifting
+    /// behind them by the loop's delays.
     fn due(&self, engine: &Engine, t: f64) -> bool {
-        let since = t - self.last_tick_s;
-        since >= self.period_s && (engine.motion_complete() || since >= self.period_s + LATE_TICK_S)
+        tick_due(
+            t - self.last_tick_s,
+            self.period_s,
+            engine.motion_complete(),
+            self.last_stamp_s,
+        )
     }
 
     /// One tick at `t`: the watchdog, the job, the status, the learnt state; false when the compute
     /// thread has ended.
     fn tick(&mut self, engine: &mut Engine, th: &Threads, t: f64) -> bool {
         self.last_tick_s = t;
+        self.last_stamp_s = engine.motion_complete().map_or(f64::NEG_INFINITY, |(s, _)| s);
         if th.compute.is_finished() {
             self.compute_ended();
             return false;
@@ -348,8 +375,11 @@ impl Cadence {
         }
         let rec = crate::shell::record::Record::Tick(crate::shell::record::TickRecord { clock_s: t });
         record(&mut self.recorder, t, rec);
+        let _span = tracing::debug_span!("tick", clock_s = t).entered();
+        let building = Instant::now();
         if let Some(job) = engine.tick(t) {
-            let _ = th.job_tx.send(job);
+            self.build_ms = building.elapsed().as_secs_f64() * 1e3;
+            let _ = th.job_tx.send((job, Instant::now()));
             self.outstanding = Some(Instant::now());
         }
         let _ = th.out_tx.send(Output::Status(engine.status(t, wall_s(), true)));
@@ -357,6 +387,7 @@ impl Cadence {
             && t - *saved_s >= *every_s
         {
             *saved_s = t;
+            let _span = tracing::debug_span!("snapshot").entered();
             let (p, state) = (p.clone(), engine.state(t));
             // written off the loop: a few megabytes
             tokio::task::spawn_blocking(move || keep_state(&p, &state));
@@ -365,13 +396,15 @@ impl Cadence {
     }
 
     /// A finished job: published (and recorded), the watchdog fed again.
-    fn done(&mut self, engine: &mut Engine, th: &Threads, d: Done, t: f64) {
+    fn done(&mut self, engine: &mut Engine, th: &Threads, mut d: Done, t: f64) {
         self.outstanding = None;
+        d.times.build_ms = self.build_ms;
         if self.hung {
             tracing::warn!("the compute thread finished its forecast at last: the watchdog is fed again");
             self.hung = false;
         }
-        if let Some(out) = engine.done(d) {
+        let _span = tracing::debug_span!("publish", t0_s = d.header.issue_time_s).entered();
+        if let Some(out) = engine.done(d, t) {
             if let Output::Forecast(h, v) = &out {
                 let rec = crate::shell::record::Record::Forecast(crate::shell::record::ForecastRecord::of(h, v));
                 record(&mut self.recorder, t, rec);
@@ -386,6 +419,21 @@ impl Cadence {
         );
         self.failure = Some("the compute thread ended unexpectedly");
     }
+}
+
+/// [`Cadence::due`]'s rule: `since_s` since the last tick on the loop's clock, `complete` the newest
+/// stamp and the stamps' jitter allowance when every vessel's sample is in, `last_stamp_s` the newest
+/// stamp at the last tick.
+fn tick_due(since_s: f64, period_s: f64, complete: Option<(f64, f64)>, last_stamp_s: f64) -> bool {
+    if since_s >= period_s + LATE_TICK_S {
+        return true;
+    }
+    // a period on both clocks, less the jitter allowances: the sensors' (a tick keeps their phase) and
+    // the loop's (data replayed faster than real time, or a backlog delivered at once, starts one
+    // forecast a period, not several)
+    complete.is_some_and(|(stamp_s, jitter_s)| {
+        since_s >= period_s - ARRIVAL_JITTER_S && stamp_s - last_stamp_s >= period_s - jitter_s
+    })
 }
 
 /// Takes the learnt state kept at `path` into the engine, or says why not (the daemon then starts
@@ -459,5 +507,66 @@ pub fn to_wire(s: &crate::sim::ImuSample) -> MotionSample {
         time_s: s.time_s,
         x: s.x,
         v: s.v,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 10 Hz stream whose samples arrive 0-3 ms after their stamps (loop clock = data clock) and a
+    /// look timer every 50 ms: each tick comes with a sample (no wait), and the ticks' stamps are a
+    /// period apart all run long (a rule on the loop's clock alone drifts a sample interval behind
+    /// whenever a sample arrives a hair early, then waits for the look timer).
+    #[test]
+    fn the_cadence_ticks_with_the_sample_a_period_after_the_last() {
+        let period_s = 1.0;
+        let (mut last_tick_s, mut last_stamp_s) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let mut newest: Option<f64> = None;
+        let mut ticks = vec![];
+        // events: (loop time, Some(stamp) for a sample, None for the look timer)
+        let mut events: Vec<(f64, Option<f64>)> = (0..3000)
+            .map(|k| {
+                let stamp = k as f64 * 0.1;
+                // a deterministic jitter of 0-3 ms
+                (stamp + 0.003 * ((k * 7919 % 13) as f64 / 12.0), Some(stamp))
+            })
+            .collect();
+        events.extend((0..6000).map(|j| (j as f64 * 0.05 + 0.0271, None)));
+        events.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (t, sample) in events {
+            if let Some(s) = sample {
+                newest = Some(s);
+            }
+            let complete = newest.map(|s| (s, 0.05));
+            if tick_due(t - last_tick_s, period_s, complete, last_stamp_s) {
+                last_tick_s = t;
+                last_stamp_s = newest.unwrap_or(f64::NEG_INFINITY);
+                ticks.push((t, last_stamp_s));
+            }
+        }
+        assert!(ticks.len() >= 295, "{} ticks", ticks.len());
+        for w in ticks.windows(2).skip(1) {
+            let (a, b) = (w[0], w[1]);
+            assert!(
+                (b.1 - a.1 - period_s).abs() < 1e-9,
+                "ticks' stamps {} s apart",
+                b.1 - a.1
+            );
+            // the tick comes with its sample (within the 3 ms jitter of its arrival)
+            assert!(b.0 - b.1 <= 0.0031, "tick {} s after its sample's stamp", b.0 - b.1);
+        }
+    }
+
+    #[test]
+    fn without_a_complete_set_a_tick_comes_late_and_fast_data_ticks_a_period_apart() {
+        // the other vessel's sample missing: late by LATE_TICK_S, not never
+        assert!(!tick_due(1.0 + 0.5 * LATE_TICK_S, 1.0, None, 0.0));
+        assert!(tick_due(1.0 + LATE_TICK_S, 1.0, None, 0.0));
+        // a backlog of samples a period on (or data faster than real time), a tenth of a period after
+        // the last tick: wait for the period on the loop's clock too
+        assert!(!tick_due(0.1, 1.0, Some((5.0, 0.05)), 3.0));
+        assert!(!tick_due(0.95, 1.0, Some((5.0, 0.05)), 3.0));
+        assert!(tick_due(0.995, 1.0, Some((5.0, 0.05)), 3.0));
     }
 }

@@ -62,9 +62,9 @@ pub const COVERAGE_SECTORS: usize = 72;
 impl Region {
     /// Whether an earth point is inside the observed region (a point region: never).
     pub fn contains(&self, p: [f64; 2]) -> bool {
-        match *self {
+        match self {
             Region::Everywhere => true,
-            Region::Disc { centre_m, radius_m } => (p[0] - centre_m[0]).hypot(p[1] - centre_m[1]) <= radius_m,
+            Region::Disc { centre_m, radius_m } => (p[0] - centre_m[0]).hypot(p[1] - centre_m[1]) <= *radius_m,
             Region::Point { .. } => false,
             Region::Coverage {
                 centre_m,
@@ -72,10 +72,16 @@ impl Region {
                 ranges_m,
                 ..
             } => {
+                // squared distances and a polynomial bearing, the bearing only where the distance
+                // allows: the known leads' march asks this millions of times a forecast
+                // (`horizon::known_leads`)
                 let (dx, dy) = (p[0] - centre_m[0], p[1] - centre_m[1]);
-                let j = coverage_sector(dy.atan2(dx));
-                let r = dx.hypot(dy);
-                r >= inner_m && r <= ranges_m[j]
+                let r2 = dx * dx + dy * dy;
+                if r2 < inner_m * inner_m {
+                    return false;
+                }
+                let range = ranges_m[coverage_sector_of(dx, dy)];
+                r2 <= range * range
             }
         }
     }
@@ -85,6 +91,38 @@ impl Region {
 pub fn coverage_sector(direction_rad: f64) -> usize {
     let f = direction_rad.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU;
     ((f * COVERAGE_SECTORS as f64) as usize).min(COVERAGE_SECTORS - 1)
+}
+
+/// The [`Region::Coverage`] sector of the direction of `(dx, dy)` (east, north), by
+/// [`bearing_rad`]: what a coverage is built and asked with.
+pub fn coverage_sector_of(dx: f64, dy: f64) -> usize {
+    let b = bearing_rad(dx, dy);
+    let f = if b < 0.0 { b + std::f64::consts::TAU } else { b } / std::f64::consts::TAU;
+    ((f * COVERAGE_SECTORS as f64) as usize).min(COVERAGE_SECTORS - 1)
+}
+
+/// `dy.atan2(dx)` within 2e-6 rad (a minimax polynomial of atan on [0, 1], by octant), several times
+/// cheaper than libm's: a coverage's sectors are 5 deg wide, so a point can change sector only
+/// within 2e-6 rad of a sector's edge, and the coverage is built with the same function
+/// ([`coverage_sector_of`]). (0, 0): 0.
+pub fn bearing_rad(dx: f64, dy: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (dx.abs(), dy.abs());
+    let (lo, hi) = if ay > ax { (ax, ay) } else { (ay, ax) };
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let a = lo / hi;
+    let s = a * a;
+    let mut r = a
+        * (0.99997726 + s * (-0.33262347 + s * (0.19354346 + s * (-0.11643287 + s * (0.05265332 + s * -0.01172120)))));
+    if ay > ax {
+        r = FRAC_PI_2 - r;
+    }
+    if dx < 0.0 {
+        r = PI - r;
+    }
+    if dy < 0.0 { -r } else { r }
 }
 
 /// A phase-resolved wave field.
@@ -445,6 +483,27 @@ pub fn group_velocity(omega_rad_s: f64, g_m_s2: f64, depth_m: Option<f64>) -> f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What the polynomial bearing may differ from libm's atan2 by, rad (its fit's error is 1.7e-6).
+    const BEARING_TOLERANCE_RAD: f64 = 2e-6;
+
+    #[test]
+    fn the_bearing_is_atan2_to_its_tolerance_all_round() {
+        let mut worst = 0.0f64;
+        for k in 0..=7200 {
+            let a = (k as f64 / 7200.0 - 0.5) * std::f64::consts::TAU;
+            for r in [1e-3, 1.0, 2500.0] {
+                let (dx, dy) = (r * a.cos(), r * a.sin());
+                // the same direction either side of the branch cut at +-pi
+                let d = (bearing_rad(dx, dy) - dy.atan2(dx)).rem_euclid(std::f64::consts::TAU);
+                worst = worst.max(d.min(std::f64::consts::TAU - d));
+            }
+        }
+        assert!(worst < BEARING_TOLERANCE_RAD, "worst {worst:e} rad");
+        assert_eq!(bearing_rad(0.0, 0.0), 0.0);
+        assert_eq!(coverage_sector_of(1.0, -1e-9), COVERAGE_SECTORS - 1);
+        assert_eq!(coverage_sector_of(1.0, 0.0), 0);
+    }
     use std::f64::consts::PI;
 
     fn field() -> WaveField {

@@ -18,7 +18,7 @@
 //! Probe: the record's FFT (the seed paper's method), long-crested along a given direction, amplitudes
 //! referred to the probe and the record's last sample.
 
-use super::field::{COVERAGE_SECTORS, Error, FieldComponent, Region, Result, WaveField, coverage_sector};
+use super::field::{COVERAGE_SECTORS, Error, FieldComponent, Region, Result, WaveField, coverage_sector_of};
 use num_complex::Complex64;
 use rustfft::FftPlanner;
 use std::f64::consts::PI;
@@ -246,7 +246,7 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
             }
             let p = frame.to_earth(first.x_m[ix], first.y_m[iy]);
             let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
-            let j = coverage_sector(dy.atan2(dx));
+            let j = coverage_sector_of(dx, dy);
             ranges_m[j] = ranges_m[j].max(dx.hypot(dy));
             nearest_m = nearest_m.min(dx.hypot(dy));
         }

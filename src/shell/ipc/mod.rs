@@ -251,10 +251,16 @@ pub fn encode_elevation(scan: &Scan) -> (ElevationHeader, Vec<f32>) {
     )
 }
 
-/// Spawns the daemon's input thread. It ends when `stop` is set or the channel closes.
+/// What the input thread hands on: each input with the engine clock at its receipt (taken here, so
+/// that the daemon's loop being busy does not make an input look late, or its source's clock step).
+pub type Arrived = (Input, f64);
+
+/// Spawns the daemon's input thread: each input is stamped with `clock` (the engine clock) as it is
+/// received. It ends when `stop` is set or the channel closes.
 pub fn spawn_input(
     names: Names,
-    tx: tokio::sync::mpsc::Sender<Input>,
+    tx: tokio::sync::mpsc::Sender<Arrived>,
+    clock: impl Fn() -> f64 + Send + 'static,
     stop: Arc<AtomicBool>,
     ready: std::sync::mpsc::Sender<Result<()>>,
 ) -> std::thread::JoinHandle<()> {
@@ -289,7 +295,7 @@ pub fn spawn_input(
                 return;
             };
             // whatever was there before we attached (history of the waves service)
-            if !ports.drain(&tx) {
+            if !ports.drain(&tx, &clock) {
                 return;
             }
             loop {
@@ -298,7 +304,7 @@ pub fn spawn_input(
                 }
                 let mut alive = true;
                 let r = ws.wait_and_process_once(|_| {
-                    alive = ports.drain(&tx);
+                    alive = ports.drain(&tx, &clock);
                     CallbackProgression::Stop
                 });
                 if r.is_err() || !alive {
@@ -367,7 +373,7 @@ impl InputPorts {
 
     /// Forwards everything received (decoded; what cannot be, as a rejection); false when the channel
     /// has closed.
-    fn drain(&self, tx: &tokio::sync::mpsc::Sender<Input>) -> bool {
+    fn drain(&self, tx: &tokio::sync::mpsc::Sender<Arrived>, clock: &impl Fn() -> f64) -> bool {
         let _ = self.motion_l.try_wait(|_| {});
         let _ = self.waves_l.try_wait(|_| {});
         let _ = self.nav_l.try_wait(|_| {});
@@ -377,17 +383,17 @@ impl InputPorts {
                 Ok(scan) => Input::Elevation(Box::new(scan)),
                 Err(e) => Input::Rejected(e),
             };
-            if tx.blocking_send(msg).is_err() {
+            if tx.blocking_send((msg, clock())).is_err() {
                 return false;
             }
         }
         while let Ok(Some(s)) = self.motion.receive() {
-            if tx.blocking_send(Input::Motion(*s.payload())).is_err() {
+            if tx.blocking_send((Input::Motion(*s.payload()), clock())).is_err() {
                 return false;
             }
         }
         while let Ok(Some(s)) = self.nav.receive() {
-            if tx.blocking_send(Input::Navigation(*s.payload())).is_err() {
+            if tx.blocking_send((Input::Navigation(*s.payload()), clock())).is_err() {
                 return false;
             }
         }
@@ -396,13 +402,13 @@ impl InputPorts {
                 Ok(f) => Input::Waves(f),
                 Err(e) => Input::Rejected(e),
             };
-            if tx.blocking_send(msg).is_err() {
+            if tx.blocking_send((msg, clock())).is_err() {
                 return false;
             }
         }
         // the link's health comes a second at a time: read at every wake (the interval's too)
         while let Ok(Some(s)) = self.link.receive() {
-            if tx.blocking_send(Input::Link(*s.payload())).is_err() {
+            if tx.blocking_send((Input::Link(*s.payload()), clock())).is_err() {
                 return false;
             }
         }

@@ -56,7 +56,7 @@ pub fn drive_from(
         pace(at);
         if let Some(job) = engine.tick(at) {
             let d = computer.run(job, || 0.0);
-            if let Some(o @ Output::Forecast(..)) = engine.done(d) {
+            if let Some(o @ Output::Forecast(..)) = engine.done(d, at) {
                 on_output(o);
             }
             computer.tune();
