@@ -56,6 +56,17 @@ fn beyond(x: f64, bound: f64) -> f64 {
 /// (`Engine::heel_square`): several correlation times of an MRU's drift (600 s) at the default 300 s.
 pub const HEEL_MEMORY_BIAS_TIMES: f64 = 3.0;
 
+/// Every vessel's newest motion sample in ([`Engine::motion_complete`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionSet {
+    /// The newest stamp of all, s (data clock).
+    pub stamp_s: f64,
+    /// Half the longest sample interval: what the stamps may jitter by, s.
+    pub jitter_s: f64,
+    /// When the last of them arrived, s (engine clock).
+    pub arrival_s: f64,
+}
+
 /// A forecast's leads from this one on are settled (past a roll's decay, 1 / (zeta w_n) = 47 s at 5 %
 /// of critical and 0.43 rad/s): their mean is the model's own mean in waves, s.
 pub const SETTLED_LEAD_S: f64 = 60.0;
@@ -317,19 +328,23 @@ impl Engine {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)))
     }
 
-    /// When every vessel's newest motion sample is in, the newest stamp of all and half the longest
-    /// sample interval (the stamps' own jitter allowance): each vessel whose motion is not stale
-    /// (within `forecast.max_motion_age_s` of the newest of all) has one within half its own sample
-    /// interval of the newest of all (the daemon ticks on that: a forecast then starts from the newest
-    /// motion, not from one up to a sample interval older). None before any motion, or while a
-    /// vessel's sample is still to come.
-    pub fn motion_complete(&self) -> Option<(f64, f64)> {
+    /// When every vessel's newest motion sample is in: the newest stamp of all, half the longest sample
+    /// interval (the stamps' jitter allowance) and the clock time the last of them arrived. Each vessel
+    /// whose motion is not stale (within `forecast.max_motion_age_s` of the newest of all) has one
+    /// within half its own sample interval of the newest of all (the daemon ticks on that: a forecast
+    /// then starts from the newest motion, not from one up to a sample interval older). None before any
+    /// motion, or while a vessel's sample is still to come.
+    pub fn motion_complete(&self) -> Option<MotionSet> {
         let (_, hi) = self.newest_motion_s();
         if !hi.is_finite() {
             return None;
         }
-        let mut half_interval_s = 0.0f64;
-        for h in &self.hist {
+        let mut set = MotionSet {
+            stamp_s: hi,
+            jitter_s: 0.0,
+            arrival_s: f64::NEG_INFINITY,
+        };
+        for (h, arrival) in self.hist.iter().zip(&self.arrival) {
             match h.newest_time_s() {
                 Some(t) if hi - t <= self.cfg.max_motion_age_s => {
                     let rate = h.rate_hz();
@@ -337,12 +352,13 @@ impl Engine {
                     if hi - t > half {
                         return None;
                     }
-                    half_interval_s = half_interval_s.max(half);
+                    set.jitter_s = set.jitter_s.max(half);
+                    set.arrival_s = set.arrival_s.max(arrival.unwrap_or(f64::NEG_INFINITY));
                 }
                 _ => {}
             }
         }
-        Some((hi, half_interval_s))
+        Some(set)
     }
 
     /// Radiation memory the engine keeps, s.
