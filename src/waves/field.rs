@@ -87,12 +87,6 @@ impl Region {
     }
 }
 
-/// The [`Region::Coverage`] sector of a direction (rad, counterclockwise from east).
-pub fn coverage_sector(direction_rad: f64) -> usize {
-    let f = direction_rad.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU;
-    ((f * COVERAGE_SECTORS as f64) as usize).min(COVERAGE_SECTORS - 1)
-}
-
 /// The [`Region::Coverage`] sector of the direction of `(dx, dy)` (east, north), by
 /// [`bearing_rad`]: what a coverage is built and asked with.
 pub fn coverage_sector_of(dx: f64, dy: f64) -> usize {
