@@ -198,8 +198,8 @@ impl Computer {
             waves: job.waves.clone(),
             track: job.track,
         });
-        let t_start_ms = elapsed_ms();
-        let mut t_forecast_ms = t_start_ms;
+        // the band's start, when the forecast succeeds (else the band is nothing)
+        let mut t_forecast_ms = elapsed_ms();
         let result = {
             let _span = tracing::debug_span!("forecast", t0_s = job.t0_s).entered();
             self.forecast(&job)
