@@ -12,7 +12,8 @@
 //! - a stamp more than `max_clock_skew_s` ahead of the reference is refused as from the future (a clock
 //!   glitch must not make every later genuine sample look late); a source whose clock may run faster
 //!   than the engine's (a simulator at `simulate.speed`) is allowed `max_rate - 1` more seconds ahead
-//!   per second since its last accepted sample;
+//!   per second since its last accepted sample (a sample of such a source that arrives more than the skew
+//!   behind where its clock may have run is accepted and leaves the reference alone: it waited);
 //! - a stamp more than `max_clock_lag_s` behind it is refused as from the past;
 //! - `clock_resync_samples` consecutive refused samples that agree with each other (within the skew) are
 //!   a step of the source's clock: the source re-synchronizes to them ([`Stamp::Stepped`]), and the
@@ -89,7 +90,13 @@ impl SourceClock {
             }
         } else {
             self.candidate = None;
-            self.reference = Some((offset.max(floor), clock_s));
+            // a faster source's sample that waited (in a service's history, say) is accepted but
+            // leaves the reference where the clock may have run to: moved to it, the next fresh
+            // sample would look ahead by the wait times the rate
+            let waited = fast_s > 0.0 && offset < reference + fast_s * elapsed_s - rules.max_skew_s;
+            if !waited {
+                self.reference = Some((offset.max(floor), clock_s));
+            }
             return Stamp::Accepted;
         };
         let count = match self.candidate {
@@ -196,6 +203,20 @@ mod tests {
         let mut slow = SourceClock::default();
         assert_eq!(slow.judge(1.7e9, 0.0, &RULES), Stamp::Accepted);
         assert!(matches!(slow.judge(1.7e9 + 2.0, 0.5, &RULES), Stamp::Future { .. }));
+    }
+
+    /// Was: a sample that waited 0.4 s (the waves service's history, read by a daemon just started)
+    /// moved the reference back with the engine's clock, and every fresh field after it was refused as
+    /// ahead until the clock was re-synchronized and the wave history thrown away.
+    #[test]
+    fn a_faster_source_s_sample_that_waited_does_not_make_the_next_fresh_one_look_ahead() {
+        let fast = ClockRules { max_rate: 4.0, ..RULES };
+        let mut c = SourceClock::default();
+        for k in 0..40 {
+            let t = k as f64 * 0.5;
+            let arrived = if k == 20 { t + 0.4 } else { t };
+            assert_eq!(c.judge(1.7e9 + 4.0 * t, arrived, &fast), Stamp::Accepted, "{k}");
+        }
     }
 
     #[test]
