@@ -6,8 +6,9 @@ use super::dense;
 use super::model::{Kernel, NlScratch, TimeModel};
 use super::{Error, Result};
 use crate::radiation::history::Memory;
-use crate::radiation::partitioned::PartitionedRun;
+use crate::radiation::partitioned::{PartitionedRun, Partitions, block_for_run};
 use multiversion::multiversion;
+use std::sync::{Arc, Weak};
 
 /// Displacement beyond which a state counts as unbounded (m or rad).
 pub const UNBOUNDED: f64 = 1.0e4;
@@ -27,6 +28,11 @@ pub struct Stepper {
     buf: Vec<f64>,
     /// Convolution: the run's velocities (v_1 on) against the taps beyond one block.
     run: PartitionedRun,
+    /// Convolution: the partitions this run uses: the model's, or a set blocked for the run's length.
+    active: Option<Arc<Partitions>>,
+    /// Convolution: the sets blocked for shorter runs, built for the model whose partitions these are.
+    sized: Vec<Arc<Partitions>>,
+    sized_for: Weak<Partitions>,
     /// State space: the modes' states (r real parts, then r imaginary parts), held one half-update
     /// ahead during a run (see [`crate::radiation::modal`]), and their input b . v at the start, laid out alike.
     states: Vec<f64>,
@@ -54,6 +60,10 @@ pub struct Stepper {
 pub const NL_TOLERANCE: f64 = 1e-10;
 /// ... or for at most this many passes (each pass is one force evaluation and one n x n product).
 pub const NL_MAX_PASSES: usize = 12;
+
+/// Partition sets blocked for shorter runs a stepper keeps (its forecasts' length and the estimator's
+/// runs; each a few MB).
+const SIZED_KEPT: usize = 4;
 
 impl Stepper {
     pub fn new() -> Self {
@@ -134,10 +144,12 @@ impl Stepper {
         frad.iter_mut().for_each(|f| *f = 0.0);
         match (&model.kernel, memory) {
             (Kernel::Convolution { taps, k, parts }, Memory::Convolution { .. }) => {
+                let parts = self.partitions_for(parts, k, *taps, n, steps);
                 // the run's input s_0 is zero: v_0 and the history are the caller's known part
-                self.run.reset(parts);
+                self.run.reset(&parts);
                 self.v_new.iter_mut().for_each(|v| *v = 0.0);
-                self.run.push(parts, &self.v_new);
+                self.run.push(&parts, &self.v_new);
+                self.active = Some(parts);
                 let p0 = self.pos(0);
                 self.buf[p0..p0 + n].copy_from_slice(v0);
                 for m in 1..*taps {
@@ -280,7 +292,7 @@ impl Stepper {
             Kernel::Convolution { parts, .. } => {
                 let p = self.pos(k1 as isize);
                 self.buf[p..p + n].copy_from_slice(&self.v_new);
-                self.run.push(parts, &self.v_new);
+                self.run.push(self.active.as_deref().unwrap_or(parts), &self.v_new);
             }
             Kernel::StateSpace { step, .. } => step.advance(&self.v_new, &mut self.states, &mut self.rad_next),
         }
@@ -303,6 +315,7 @@ impl Stepper {
         let n = self.n;
         match &model.kernel {
             Kernel::Convolution { taps, k, parts } => {
+                let parts = self.active.as_deref().unwrap_or(parts);
                 // taps 1..B-1 over v_k1-1 back to v_1 directly; the partitions have the rest
                 let mcount = (k1 - 1).min(parts.block - 1).min(taps - 1);
                 let start = self.pos(k1 as isize - 1);
@@ -317,6 +330,37 @@ impl Stepper {
             // when they were
             Kernel::StateSpace { .. } => self.p.copy_from_slice(&self.rad_next),
         }
+    }
+
+    /// The partitions a run of `steps` steps uses: the model's (`model_parts`, blocked for runs past the
+    /// kernel's length), or a set of the same kernel (`k`, `taps` taps, `n` states) blocked for the
+    /// run's length ([`block_for_run`]), built once per model and block and kept.
+    fn partitions_for(
+        &mut self,
+        model_parts: &Arc<Partitions>,
+        k: &[f64],
+        taps: usize,
+        n: usize,
+        steps: usize,
+    ) -> Arc<Partitions> {
+        let block = block_for_run(taps, steps);
+        if block == model_parts.block {
+            return model_parts.clone();
+        }
+        if !std::ptr::eq(self.sized_for.as_ptr(), Arc::as_ptr(model_parts)) {
+            self.sized.clear();
+            self.sized_for = Arc::downgrade(model_parts);
+        }
+        if let Some(p) = self.sized.iter().find(|p| p.block == block && p.steps >= steps) {
+            return p.clone();
+        }
+        // room for runs up to twice as long, so a run a little longer does not build again
+        let p = Arc::new(Partitions::reaching(k, taps, n, block, steps.next_power_of_two()));
+        if self.sized.len() >= SIZED_KEPT {
+            self.sized.remove(0);
+        }
+        self.sized.push(p.clone());
+        p
     }
 
     /// The error of a step `k1` that left the bounds: the first DOF non-finite or beyond 1e4 m or rad.

@@ -174,12 +174,90 @@ fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64;
     [start, t]
 }
 
+/// [`coverage_span`] of every component for a vessel at rest, on the same steps. At rest the water a
+/// group brings at lead t was, a scan tau earlier, at `position - c_g d (t + tau)`: on the ray from
+/// the vessel against the group's direction, at c_g (t + tau) metres. The ray is marched once per
+/// direction (every frequency shares it) and each component reads its leads off it: the field's
+/// thousands of components cost a march per direction, not one each.
+fn coverage_spans_at_rest(field: &WaveField, position: [f64; 2]) -> Vec<[f64; 2]> {
+    let Region::Coverage {
+        ranges_m,
+        centre_m,
+        window_s,
+        ..
+    } = field.region
+    else {
+        return vec![[0.0, 0.0]; field.components.len()];
+    };
+    let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
+    let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
+    let step_m = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS);
+    let window_s = if window_s.is_finite() { window_s.max(0.0) } else { 0.0 };
+    let reach_steps = (reach / step_m).floor() as usize + 1;
+    // per direction, seen[j]: the count of samples j' < j of the ray inside the region
+    let mut rays: Vec<(f64, Vec<u32>)> = vec![];
+    let mut ray_of: std::collections::HashMap<u64, usize> = std::collections::HashMap::new();
+    field
+        .components
+        .iter()
+        .map(|c| {
+            let cg = group_velocity(c.omega_rad_s, field.g_m_s2, field.depth_m);
+            if !(cg > 0.0 && cg.is_finite()) {
+                let d = [c.direction_rad.cos(), c.direction_rad.sin()];
+                let rel = [-cg * d[0], -cg * d[1]];
+                return coverage_span(&field.region, position, rel, rel);
+            }
+            // the samples beyond a lead's that its window of scans saw (never past the window)
+            let wide = (cg * window_s / step_m).floor() as usize;
+            let at = *ray_of.entry(c.direction_rad.to_bits()).or_insert_with(|| {
+                rays.push((c.direction_rad, vec![]));
+                rays.len() - 1
+            });
+            let ray = &mut rays[at];
+            let need = reach_steps + wide + 2;
+            if ray.1.len() < need + 1 {
+                let (back_x, back_y) = (-ray.0.cos(), -ray.0.sin());
+                let mut count = ray.1.last().copied().unwrap_or(0);
+                if ray.1.is_empty() {
+                    ray.1.push(0);
+                }
+                for j in ray.1.len() - 1..need {
+                    let r = j as f64 * step_m;
+                    count += u32::from(
+                        field
+                            .region
+                            .contains([position[0] + back_x * r, position[1] + back_y * r]),
+                    );
+                    ray.1.push(count);
+                }
+            }
+            let seen = |i: usize| ray.1[(i + wide + 1).min(need)] > ray.1[i];
+            let dt = step_m / cg;
+            let mut i = 0;
+            while !seen(i) {
+                i += 1;
+                if i as f64 * step_m > reach {
+                    return [0.0, 0.0];
+                }
+            }
+            let start = i;
+            while i as f64 * step_m <= reach && seen(i + 1) {
+                i += 1;
+            }
+            [start as f64 * dt, i as f64 * dt]
+        })
+        .collect()
+}
+
 /// For each component of a field, the lead times (s, from the field's time) over which the waves it
 /// brings to a vessel at `position_m` moving at `velocity_m_s` (earth frame) had been observed:
 /// inside the observed disc or coverage at the field's time (a coverage: or at an earlier scan of its
 /// window), or past the probe within its fitted
 /// window (a probe whose window is not said: from 0). Known everywhere: [0, infinity).
 pub fn known_leads(field: &WaveField, position_m: [f64; 2], velocity_m_s: [f64; 2]) -> Vec<[f64; 2]> {
+    if matches!(field.region, Region::Coverage { .. }) && velocity_m_s == [0.0, 0.0] {
+        return coverage_spans_at_rest(field, position_m);
+    }
     field
         .components
         .iter()
@@ -283,6 +361,10 @@ mod tests {
 
     /// A field of one component of 0.6 rad/s travelling west (towards -x) observed over `region`, and
     /// its group speed, m/s.
+    /// With a window, the share of spans the ray and the march may disagree on by more than two steps
+    /// (a gap crossed as wide as the window, to a step).
+    const RAY_APART_SHARE: f64 = 0.01;
+
     fn westward(region: Region) -> (WaveField, f64) {
         use crate::waves::field::FieldComponent;
         let w = 0.6;
@@ -439,6 +521,70 @@ mod tests {
         });
         let k = known_leads(&field(blind(600.0, masked)), [0.0, 0.0], [0.0, 0.0]);
         assert_eq!(k[0], [0.0, 0.0]);
+    }
+
+    /// A vessel at rest reads its leads off one ray per direction ([`coverage_spans_at_rest`]): the
+    /// same spans as the general march's on ragged coverages, the vessel off the centre, many
+    /// frequencies sharing each direction. Without a window, to the march's step; with one, to two
+    /// (the ray takes the window's scans to its last whole step, never past it; the march to its
+    /// end), and where the ray crosses a masked sector's gap about as wide as the window one of them
+    /// bridges it: a few spans may differ more.
+    #[test]
+    fn a_vessel_at_rest_reads_the_general_march_s_spans_off_its_rays() {
+        use crate::waves::field::FieldComponent;
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut worst_steps, mut apart, mut spans): (f64, usize, usize) = (0.0, 0, 0);
+        for case in 0..9 {
+            let window_s = [0.0, 60.0, 17.3][case % 3];
+            let ranges_m = std::array::from_fn(|_| if rnd() < 0.15 { 0.0 } else { 500.0 + 1500.0 * rnd() });
+            let region = Region::Coverage {
+                centre_m: [0.0, 0.0],
+                inner_m: 150.0 + 100.0 * rnd(),
+                ranges_m,
+                window_s,
+            };
+            let components = (0..400)
+                .map(|j| FieldComponent {
+                    omega_rad_s: 0.3 + 1.2 * rnd(),
+                    direction_rad: (j % 23) as f64 * 2.0 * PI / 23.0,
+                    amplitude_m: num_complex::Complex64::new(0.1, 0.0),
+                })
+                .collect();
+            let field = WaveField {
+                components,
+                reference_m: [0.0, 0.0],
+                time_s: 0.0,
+                g_m_s2: 9.81,
+                depth_m: None,
+                region,
+            };
+            let position = [60.0 * rnd() - 30.0, 60.0 * rnd() - 30.0];
+            let at_rest = coverage_spans_at_rest(&field, position);
+            assert_eq!(at_rest.len(), field.components.len());
+            for (c, got) in field.components.iter().zip(&at_rest) {
+                let cg = group_velocity(c.omega_rad_s, 9.81, None);
+                let back = [-cg * c.direction_rad.cos(), -cg * c.direction_rad.sin()];
+                let marched = coverage_span(&field.region, position, back, back);
+                let off_steps = (0..2)
+                    .map(|e| (got[e] - marched[e]).abs() * cg / COVERAGE_STEP_M)
+                    .fold(0.0, f64::max);
+                spans += 1;
+                if window_s == 0.0 {
+                    worst_steps = worst_steps.max(off_steps);
+                } else if off_steps > 2.0 + 1e-9 {
+                    apart += 1;
+                }
+            }
+        }
+        assert!(worst_steps <= 1.0 + 1e-9, "without a window: {worst_steps} steps off");
+        assert!(
+            (apart as f64) <= RAY_APART_SHARE * spans as f64,
+            "{apart} of {spans} spans more than two steps off"
+        );
     }
 
     #[test]
