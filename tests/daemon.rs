@@ -859,6 +859,7 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
     let sub = ForecastSubscriber::new(&names).unwrap();
     // wall seconds until a forecast issued after `after_s` (data clock) that trusts the ship arrives
     // (None: not within `limit_s`), and the newest issue time read
+    let last_flags = std::cell::Cell::new((0u32, 0.0f64));
     let trusted_within = |limit_s: f64, after_s: f64| -> (Option<f64>, f64) {
         let t = Instant::now();
         let mut got = vec![];
@@ -871,6 +872,7 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
                     && h.issue_time_s > after_s
                 {
                     newest_s = newest_s.max(h.issue_time_s);
+                    last_flags.set((h.flags, h.issue_time_s));
                     if h.horizon_s[0] > 0.0 {
                         return (Some(t.elapsed().as_secs_f64()), newest_s);
                     }
@@ -908,7 +910,11 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
     back.0.stderr.take().unwrap().read_to_string(&mut back_log).unwrap();
     assert!(
         warm_s.is_some_and(|w| w <= 15.0 && w < cold_s),
-        "warm {warm_s:?}, cold {cold_s}; the restarted daemon's log:\n{back_log}"
+        "warm {warm_s:?}, cold {cold_s}; the last forecast's (flags, issue time): {:?}; the restarted daemon's log:\n{back_log}",
+        (
+            shipcast::shell::ipc::wire::flags::names(last_flags.get().0),
+            last_flags.get().1
+        )
     );
     // a corrupt state: refused, named, a cold start
     std::fs::write(&path, b"shipcast state\n\x07\x07\x07").unwrap();

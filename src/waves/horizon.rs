@@ -176,9 +176,10 @@ fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64;
 
 /// [`coverage_span`] of every component for a vessel at rest, on the same steps. At rest the water a
 /// group brings at lead t was, a scan tau earlier, at `position - c_g d (t + tau)`: on the ray from
-/// the vessel against the group's direction, at c_g (t + tau) metres. The ray is marched once per
-/// direction (every frequency shares it) and each component reads its leads off it: the field's
-/// thousands of components cost a march per direction, not one each.
+/// the vessel against the group's direction, at c_g (t + tau) metres. A lead's window of scans is
+/// then a stretch of that ray, read off running counts of its samples inside the region (one test per
+/// sample, where the march tests each of the window's scans), and the ray is kept for the direction:
+/// the frequencies that share it march no further than the farthest of them.
 fn coverage_spans_at_rest(field: &WaveField, position: [f64; 2]) -> Vec<[f64; 2]> {
     let Region::Coverage {
         ranges_m,
@@ -193,8 +194,7 @@ fn coverage_spans_at_rest(field: &WaveField, position: [f64; 2]) -> Vec<[f64; 2]
     let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
     let step_m = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS);
     let window_s = if window_s.is_finite() { window_s.max(0.0) } else { 0.0 };
-    let reach_steps = (reach / step_m).floor() as usize + 1;
-    // per direction, seen[j]: the count of samples j' < j of the ray inside the region
+    // per direction, the count of the ray's samples j' < j inside the region, for j = 0, 1, ...
     let mut rays: Vec<(f64, Vec<u32>)> = vec![];
     let mut ray_of: std::collections::HashMap<u64, usize> = std::collections::HashMap::new();
     field
@@ -210,28 +210,24 @@ fn coverage_spans_at_rest(field: &WaveField, position: [f64; 2]) -> Vec<[f64; 2]
             // the samples beyond a lead's that its window of scans saw (never past the window)
             let wide = (cg * window_s / step_m).floor() as usize;
             let at = *ray_of.entry(c.direction_rad.to_bits()).or_insert_with(|| {
-                rays.push((c.direction_rad, vec![]));
+                rays.push((c.direction_rad, vec![0]));
                 rays.len() - 1
             });
-            let ray = &mut rays[at];
-            let need = reach_steps + wide + 2;
-            if ray.1.len() < need + 1 {
-                let (back_x, back_y) = (-ray.0.cos(), -ray.0.sin());
-                let mut count = ray.1.last().copied().unwrap_or(0);
-                if ray.1.is_empty() {
-                    ray.1.push(0);
+            let (direction_rad, seen_before) = &mut rays[at];
+            let back = [-direction_rad.cos(), -direction_rad.sin()];
+            // lead step i is seen if a sample i..=i + wide of the ray is inside; the ray is marched
+            // only as far as a lead asks (as the general march goes), and kept for the direction
+            let mut seen = |i: usize| {
+                let last = i + wide + 1;
+                while seen_before.len() <= last {
+                    let r = (seen_before.len() - 1) as f64 * step_m;
+                    let inside = field
+                        .region
+                        .contains([position[0] + back[0] * r, position[1] + back[1] * r]);
+                    seen_before.push(seen_before[seen_before.len() - 1] + u32::from(inside));
                 }
-                for j in ray.1.len() - 1..need {
-                    let r = j as f64 * step_m;
-                    count += u32::from(
-                        field
-                            .region
-                            .contains([position[0] + back_x * r, position[1] + back_y * r]),
-                    );
-                    ray.1.push(count);
-                }
-            }
-            let seen = |i: usize| ray.1[(i + wide + 1).min(need)] > ray.1[i];
+                seen_before[last] > seen_before[i]
+            };
             let dt = step_m / cg;
             let mut i = 0;
             while !seen(i) {
