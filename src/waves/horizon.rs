@@ -118,13 +118,9 @@ fn disc_span(offset: [f64; 2], radius: f64, rel: [f64; 2]) -> [f64; 2] {
     if t1 < 0.0 { [0.0, 0.0] } else { [t0.max(0.0), t1] }
 }
 
-/// [`disc_span`] for a coverage region, marched in steps of [`COVERAGE_STEP_M`] or more: the first step
-/// seen, then the first not seen after it ([0, 0]: never seen within reach). The water at lead t is at
-/// `position + rel t` at the field's time; a scan `tau` earlier (up to the region's `window_s`) saw it
-/// at `position + rel t + back tau`, `back` the group's velocity reversed: a lead is seen when the
-/// water was inside the coverage at the field's time or at an earlier scan of its window (the region
-/// taken as it was at the field's time: the union of what the window's scans saw).
-fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64; 2]) -> [f64; 2] {
+/// How far a coverage's march from `position` goes (m), its step (m) and the window of scans (s, 0 when
+/// not finite); None for another region.
+fn coverage_march(region: &Region, position: [f64; 2]) -> Option<(f64, f64, f64)> {
     let Region::Coverage {
         ranges_m,
         centre_m,
@@ -132,13 +128,26 @@ fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64;
         ..
     } = *region
     else {
-        return [0.0, 0.0];
+        return None;
     };
     let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
     let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
     let step_m = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS);
-    let back_speed = back[0].hypot(back[1]);
     let window_s = if window_s.is_finite() { window_s.max(0.0) } else { 0.0 };
+    Some((reach, step_m, window_s))
+}
+
+/// [`disc_span`] for a coverage region, marched in steps of [`COVERAGE_STEP_M`] or more: the first step
+/// seen, then the first not seen after it ([0, 0]: never seen within reach). The water at lead t is at
+/// `position + rel t` at the field's time; a scan `tau` earlier (up to the region's `window_s`) saw it
+/// at `position + rel t + back tau`, `back` the group's velocity reversed: a lead is seen when the
+/// water was inside the coverage at the field's time or at an earlier scan of its window (the region
+/// taken as it was at the field's time: the union of what the window's scans saw).
+fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64; 2]) -> [f64; 2] {
+    let Some((reach, step_m, window_s)) = coverage_march(region, position) else {
+        return [0.0, 0.0];
+    };
+    let back_speed = back[0].hypot(back[1]);
     let (taus, dtau) = if back_speed > 0.0 && window_s > 0.0 {
         let d = step_m / back_speed;
         (
@@ -181,19 +190,9 @@ fn coverage_span(region: &Region, position: [f64; 2], rel: [f64; 2], back: [f64;
 /// sample, where the march tests each of the window's scans), and the ray is kept for the direction:
 /// the frequencies that share it march no further than the farthest of them.
 fn coverage_spans_at_rest(field: &WaveField, position: [f64; 2]) -> Vec<[f64; 2]> {
-    let Region::Coverage {
-        ranges_m,
-        centre_m,
-        window_s,
-        ..
-    } = field.region
-    else {
+    let Some((reach, step_m, window_s)) = coverage_march(&field.region, position) else {
         return vec![[0.0, 0.0]; field.components.len()];
     };
-    let far = ranges_m.iter().fold(0.0f64, |m, r| m.max(*r));
-    let reach = (position[0] - centre_m[0]).hypot(position[1] - centre_m[1]) + 2.0 * far + COVERAGE_STEP_M;
-    let step_m = COVERAGE_STEP_M.max(reach / COVERAGE_STEPS);
-    let window_s = if window_s.is_finite() { window_s.max(0.0) } else { 0.0 };
     // per direction, the count of the ray's samples j' < j inside the region, for j = 0, 1, ...
     let mut rays: Vec<(f64, Vec<u32>)> = vec![];
     let mut ray_of: std::collections::HashMap<u64, usize> = std::collections::HashMap::new();
