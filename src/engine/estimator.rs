@@ -41,6 +41,7 @@
 //!   `MEASURED_MEAN_DOFS`). The velocity history is not affected by
 //!   a constant bias. DOFs without restoring have no observable bias.
 
+use std::cell::{Ref, RefCell};
 use std::collections::VecDeque;
 
 /// The filter passes motion up to this many times the database's highest frequency.
@@ -53,6 +54,12 @@ pub const REVERT_WINDOW_S: f64 = 2.0;
 /// Samples closer than this to the newest taken are refused as duplicates: the kept window holds at
 /// most 1000 samples a second, whatever a sensor sends.
 pub const MIN_SAMPLE_INTERVAL_S: f64 = 1e-3;
+
+/// The smoother's pass back from a new sample stops where it changes an earlier sample's smoothed
+/// displacement and velocity by no more than this (m, rad; m/s, rad/s): the change only shrinks further
+/// back (the smoother's gain is a contraction), so the states kept from the pass before are the whole
+/// pass's to this.
+pub const SMOOTHED_SETTLED: f64 = 1e-12;
 
 /// A sample repeating every value of the one before this many times in a row is a stalled sensor.
 pub const STALL_REPEATS: usize = 2;
@@ -431,6 +438,22 @@ pub struct Estimator {
     /// The last restart from a jump while its new offset is not yet averaged
     /// ([`Estimator::settling`]).
     jump: Option<Jump>,
+    /// Counts the changes to `entries` other than a sample taken at the back or dropped from the
+    /// front: the smoothed states of another count are of other samples.
+    rewrites: u64,
+    /// The kept samples' smoothed states as last asked for ([`Estimator::smoothed`]).
+    smoothed: RefCell<Smoothed>,
+}
+
+/// A kept sample's time and its smoothed displacement and velocity.
+type Point = (f64, [f64; 6], [f64; 6]);
+
+/// The smoothed states of the oldest `points.len()` kept samples of `rewrites`, as smoothed back from
+/// the newest of them.
+#[derive(Debug, Clone, Default)]
+struct Smoothed {
+    rewrites: u64,
+    points: VecDeque<Point>,
 }
 
 /// What an estimator keeps across a restart of the daemon ([`Estimator::state`]).
@@ -477,12 +500,15 @@ impl Estimator {
             repeats: 0,
             moved: false,
             jump: None,
+            rewrites: 0,
+            smoothed: RefCell::default(),
         }
     }
 
     /// Forgets every sample (a step of the source's clock): the bias is the sensor's and stays.
     pub fn restart(&mut self) {
         self.entries.clear();
+        self.rewrites += 1;
         self.candidate.clear();
         self.checks.clear();
         self.next_check_s = None;
@@ -789,6 +815,7 @@ impl Estimator {
                 for _ in 0..STALL_REPEATS {
                     if self.entries.len() > 2 && self.entries.back().is_some_and(|e| e.x == x && e.v == v) {
                         self.entries.pop_back();
+                        self.rewrites += 1;
                     }
                 }
             }
@@ -899,6 +926,7 @@ impl Estimator {
     /// restart settling (a revert, a restore).
     fn put_learnt(&mut self, l: Learnt) {
         self.entries = l.entries;
+        self.rewrites += 1;
         self.bias = l.bias;
         self.innovation = l.innovation;
         self.checks = l.checks;
@@ -929,6 +957,7 @@ impl Estimator {
             }),
             None => [0.0; 6],
         };
+        self.rewrites += 1;
         let before = Learnt {
             entries: std::mem::take(&mut self.entries),
             bias: std::mem::take(&mut self.bias),
@@ -988,17 +1017,47 @@ impl Estimator {
     }
 
     /// Displacements and velocities at the kept samples: smoothed (Kalman), or as measured (raw).
-    fn smoothed(&self) -> Vec<(f64, [f64; 6], [f64; 6])> {
-        let n = self.entries.len();
-        let mut out: Vec<(f64, [f64; 6], [f64; 6])> = self.entries.iter().map(|e| (e.time_s, e.x, e.v)).collect();
-        if self.spec.method == Method::Raw || n == 0 {
-            return out;
+    /// Kept between calls: a sample taken since is smoothed back only as far as it changes the states
+    /// before it by more than [`SMOOTHED_SETTLED`], and a sample dropped from the front drops its state.
+    fn smoothed(&self) -> Ref<'_, VecDeque<Point>> {
+        {
+            let mut c = self.smoothed.borrow_mut();
+            if c.rewrites != self.rewrites {
+                c.points.clear();
+                c.rewrites = self.rewrites;
+            }
+            let first_s = self.entries.front().map_or(f64::INFINITY, |e| e.time_s);
+            while c.points.front().is_some_and(|p| p.0 < first_s) {
+                c.points.pop_front();
+            }
+            let aligned = c.points.len() <= self.entries.len()
+                && c.points.front().is_none_or(|p| p.0 == first_s)
+                && c.points
+                    .back()
+                    .is_none_or(|p| p.0 == self.entries[c.points.len() - 1].time_s);
+            if !aligned {
+                c.points.clear();
+            }
+            self.smooth_new(&mut c.points);
+        }
+        Ref::map(self.smoothed.borrow(), |c| &c.points)
+    }
+
+    /// Appends the states of the samples `points` does not have yet and smooths back from the newest
+    /// (Rauch-Tung-Striebel) until the states before them settle.
+    fn smooth_new(&self, points: &mut VecDeque<Point>) {
+        let (known, n) = (points.len(), self.entries.len());
+        if known == n {
+            return;
+        }
+        points.extend(self.entries.range(known..).map(|e| (e.time_s, e.x, e.v)));
+        if self.spec.method == Method::Raw {
+            return;
         }
         for d in 0..6 {
-            let last = &self.entries[n - 1].filtered[d];
-            let mut ms = last.m;
-            out[n - 1].1[d] = ms[0];
-            out[n - 1].2[d] = ms[1];
+            let mut ms = self.entries[n - 1].filtered[d].m;
+            points[n - 1].1[d] = ms[0];
+            points[n - 1].2[d] = ms[1];
             for k in (0..n - 1).rev() {
                 let f = &self.entries[k].filtered[d];
                 let next = &self.entries[k + 1];
@@ -1014,11 +1073,17 @@ impl Estimator {
                         ms = [f.m[0] + c00 * r0 + c01 * r1, f.m[1] + c10 * r0 + c11 * r1];
                     }
                 }
-                out[k].1[d] = ms[0];
-                out[k].2[d] = ms[1];
+                let p = &mut points[k];
+                let settled = k < known
+                    && (ms[0] - p.1[d]).abs() <= SMOOTHED_SETTLED
+                    && (ms[1] - p.2[d]).abs() <= SMOOTHED_SETTLED;
+                p.1[d] = ms[0];
+                p.2[d] = ms[1];
+                if settled {
+                    break;
+                }
             }
         }
-        out
     }
 
     /// The state at `t0_s` and the `n` velocities before it at step `dt_s`; walking back from t0, a gap
@@ -1045,7 +1110,8 @@ impl Estimator {
             gap: false,
             known: 0,
         };
-        let mut j = pts.len() - 1;
+        // the newest point at or before t0 (the walk below goes back from it)
+        let mut j = pts.partition_point(|p| p.0 <= t0_s).saturating_sub(1);
         let mut ended = false;
         // the state at t, or None where the history has ended; inside a gap longer than `max_gap_s`
         // (the sensor or the link away) nothing is known: at rest there, the history before it kept
@@ -1176,6 +1242,68 @@ mod tests {
             e.push(t, x, v).unwrap();
         }
         e
+    }
+
+    /// The pass stops where a change is below [`SMOOTHED_SETTLED`] and further back it shrinks: the
+    /// states kept are the whole pass's to a thousand of it (a nanometre), whatever the calls between.
+    const KEPT_SMOOTHED_TOL: f64 = 1e3 * SMOOTHED_SETTLED;
+
+    /// The smoothed states as a pass over every kept sample gives them (nothing kept from before).
+    fn smoothed_afresh(e: &Estimator) -> Vec<Point> {
+        let fresh = Estimator {
+            smoothed: RefCell::default(),
+            ..e.clone()
+        };
+        fresh.smoothed().iter().copied().collect()
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(32))]
+        /// The states kept between calls are the whole pass's, whatever the sensor did in between:
+        /// spikes, a re-zeroed sensor (a restart), a burst taken back (a revert), a stall, gaps, the
+        /// window's front dropping, a clock step.
+        #[test]
+        fn the_smoothed_states_kept_between_calls_are_the_whole_pass_s(
+            events in proptest::collection::vec(0u8..12, 50..400),
+            seed in 0u64..1000,
+        ) {
+            use rand::SeedableRng;
+            let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+            let mut e = Estimator::new(spec(Method::Kalman), 20.0);
+            let (mut t, mut offset) = (0.0, 0.0);
+            for ev in events {
+                let (mut x, v) = noisy_wave(t, &mut rng);
+                x[2] += offset;
+                match ev {
+                    0 => x[2] += 50.0,
+                    1 => offset += 2.0,
+                    2 => t += 3.0,
+                    3 => {
+                        // a stall seen by a forecast before the third repeat takes it back
+                        let _ = e.push(t, x, v);
+                        let _ = e.push(t + 0.02, x, v);
+                        let _ = e.smoothed();
+                        t += 0.04;
+                    }
+                    4 => e.restart(),
+                    _ => {}
+                }
+                let _ = e.push(t, x, v);
+                t += 0.1;
+                if ev >= 9 {
+                    let kept: Vec<Point> = e.smoothed().iter().copied().collect();
+                    let afresh = smoothed_afresh(&e);
+                    proptest::prop_assert_eq!(kept.len(), afresh.len());
+                    for (a, b) in kept.iter().zip(&afresh) {
+                        proptest::prop_assert_eq!(a.0, b.0);
+                        for d in 0..6 {
+                            proptest::prop_assert!((a.1[d] - b.1[d]).abs() <= KEPT_SMOOTHED_TOL, "{a:?} {b:?}");
+                            proptest::prop_assert!((a.2[d] - b.2[d]).abs() <= KEPT_SMOOTHED_TOL, "{a:?} {b:?}");
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -195,9 +195,10 @@ pub struct Forecaster {
     kept_dx: Vec<Complex64>,
     ramp: Vec<f64>,
     f0: Vec<f64>,
-    // FFT of the kernel (convolution with a history), built on first use; the forecast's own
-    // velocities are the stepper's ([`crate::radiation::partitioned`])
-    fft: Option<HistoryFft>,
+    /// The kernel's spectra for the convolution with a history, built on first use at the lengths
+    /// the last runs asked for (runs of other lengths keep their own), newest last; the forecast's own
+    /// velocities are the stepper's ([`crate::radiation::partitioned`]).
+    fft: Vec<HistoryFft>,
 }
 
 struct HistoryFft {
@@ -239,6 +240,41 @@ impl HistoryFft {
             }
         }
         self.inverse.process_with_scratch(&mut self.acc, &mut self.scratch);
+    }
+
+    /// `known[kk * n + i]` for kk in 1..=steps (within the kernel): the force at lead kk from the
+    /// velocities up to t0, sum_{m >= kk} K~_m v_{kk-m}; `velocity(m, out)` writes the velocity m steps
+    /// before t0 (`tmp`: n values of scratch).
+    fn known(
+        &mut self,
+        taps: usize,
+        steps: usize,
+        known: &mut [f64],
+        tmp: &mut [f64],
+        mut velocity: impl FnMut(usize, &mut [f64]),
+    ) {
+        let (len, n) = (self.len, self.n);
+        // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0
+        self.u.iter_mut().for_each(|c| *c = Complex64::default());
+        for m in 0..taps {
+            velocity(m, tmp);
+            for j in 0..n {
+                self.u[j * len + taps - 1 - m] = Complex64::new(tmp[j], 0.0);
+            }
+        }
+        self.transform_inputs(n);
+        let scale = 1.0 / len as f64;
+        for p in 0..n.div_ceil(2) {
+            self.output(p, n);
+            let (i, i2) = (2 * p, 2 * p + 1);
+            for kk in 1..=steps.min(taps - 1) {
+                let y = self.acc[kk + taps - 1] * scale;
+                known[kk * n + i] = y.re;
+                if i2 < n {
+                    known[kk * n + i2] = y.im;
+                }
+            }
+        }
     }
 
     /// Spectra of the weighted kernel's taps, zero-padded to `len`.
@@ -300,7 +336,7 @@ impl Forecaster {
             kept_dx: vec![],
             ramp: vec![],
             f0: vec![],
-            fft: None,
+            fft: Vec::new(),
         }
     }
 
@@ -677,41 +713,52 @@ impl Forecaster {
             return Ok(());
         };
         let (taps, n) = (*taps, model.n());
-        let len = (2 * taps).next_power_of_two();
-        if self.fft.as_ref().is_none_or(|f| f.len != len || f.n != n) {
-            self.fft = Some(HistoryFft::new(k, taps, n, len));
-        }
-        let Some(f) = self.fft.as_mut() else { return Ok(()) };
-        // u_j[p]: p = taps-1 is v0, p = taps-1-m is the velocity m steps before t0
+        // the convolution's outputs at leads 1..=steps (within the kernel) are clear of the circular
+        // wrap from a length of taps + steps on: a forecast shorter than the kernel needs no more
+        let len = fft_len(taps + steps.min(taps.saturating_sub(1)));
+        let f = match self.fft.iter().position(|f| f.len == len && f.n == n) {
+            Some(i) => i,
+            None => {
+                if self.fft.len() == HISTORY_FFTS_KEPT {
+                    self.fft.remove(0);
+                }
+                self.fft.push(HistoryFft::new(k, taps, n, len));
+                self.fft.len() - 1
+            }
+        };
+        let f = &mut self.fft[f];
         let mut tmp = std::mem::take(&mut self.f0);
         tmp.resize(n, 0.0);
-        f.u.iter_mut().for_each(|c| *c = Complex64::default());
-        for m in 0..taps {
+        f.known(taps, steps, &mut self.known, &mut tmp, |m, out| {
             if m == 0 {
-                tmp.copy_from_slice(v0);
+                out.copy_from_slice(v0);
             } else {
-                memory.velocity_ago(m - 1, n, &mut tmp);
+                memory.velocity_ago(m - 1, n, out);
             }
-            for j in 0..n {
-                f.u[j * len + taps - 1 - m] = Complex64::new(tmp[j], 0.0);
-            }
-        }
+        });
         self.f0 = tmp;
-        f.transform_inputs(n);
-        let scale = 1.0 / len as f64;
-        for p in 0..n.div_ceil(2) {
-            f.output(p, n);
-            let (i, i2) = (2 * p, 2 * p + 1);
-            for kk in 1..=steps.min(taps - 1) {
-                let y = f.acc[kk + taps - 1] * scale;
-                self.known[kk * n + i] = y.re;
-                if i2 < n {
-                    self.known[kk * n + i2] = y.im;
-                }
-            }
-        }
         Ok(())
     }
+}
+
+/// How many lengths of the kernel's spectra a forecaster keeps.
+const HISTORY_FFTS_KEPT: usize = 3;
+
+/// The smallest length of the form 2^a 3^b that is at least `min`: rustfft's mixed radices are about as
+/// fast there per point as at a power of two, which it never exceeds (10 368 for the demo's forecast,
+/// 10 286 at least, against 16 384).
+fn fft_len(min: usize) -> usize {
+    let mut best = min.next_power_of_two();
+    let mut p3 = 1usize;
+    while p3 < best {
+        let mut m = p3;
+        while m < min {
+            m *= 2;
+        }
+        best = best.min(m);
+        p3 *= 3;
+    }
+    best
 }
 
 /// `q[i * nc + c] = rows[c * n + i]`: component-major values to the output-major layout of
@@ -743,6 +790,61 @@ struct Piece {
 
 #[cfg(test)]
 mod tests {
+    /// The history's force by FFT at the run's length against the direct sum, for runs shorter than
+    /// the kernel, as long and longer, with an odd number of states (a pair's imaginary half unused).
+    #[test]
+    fn the_history_s_force_by_a_run_length_fft_is_the_direct_sum() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let (taps, n) = (57, 3);
+        let k: Vec<f64> = (0..n * taps * n).map(|_| rng.random::<f64>() - 0.5).collect();
+        let past: Vec<Vec<f64>> = (0..taps)
+            .map(|_| (0..n).map(|_| rng.random::<f64>() - 0.5).collect())
+            .collect();
+        for steps in [1, 10, 56, 57, 200] {
+            // the least length clear of the wrap, and the one a forecast takes
+            let least = taps + steps.min(taps - 1);
+            for len in [least, fft_len(least)] {
+                let mut f = HistoryFft::new(&k, taps, n, len);
+                let mut known = vec![f64::NAN; (steps + 1) * n];
+                let mut tmp = vec![0.0; n];
+                f.known(taps, steps, &mut known, &mut tmp, |m, out| {
+                    out.copy_from_slice(&past[m])
+                });
+                for kk in 1..=steps.min(taps - 1) {
+                    for i in 0..n {
+                        let direct: f64 = (kk..taps)
+                            .map(|m| (0..n).map(|j| k[(i * taps + m) * n + j] * past[m - kk][j]).sum::<f64>())
+                            .sum();
+                        let got = known[kk * n + i];
+                        assert!(
+                            (got - direct).abs() < 1e-12,
+                            "steps {steps} lead {kk} state {i}: {got} against {direct}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fft_lengths_are_2_and_3_smooth_and_the_least_such() {
+        let smooth = |mut m: usize| {
+            for p in [2, 3] {
+                while m.is_multiple_of(p) {
+                    m /= p;
+                }
+            }
+            m == 1
+        };
+        for min in 1..3000 {
+            let len = fft_len(min);
+            assert!(len >= min && smooth(len), "{min}: {len}");
+            assert!((min..len).all(|m| !smooth(m)), "{min}: {len}");
+        }
+        assert_eq!(fft_len(10_286), 10_368);
+    }
+
     use super::*;
 
     #[test]
