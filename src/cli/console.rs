@@ -106,6 +106,8 @@ fn subscribe(names: Names, n_vessels: usize, tx: mpsc::Sender<Event>, stop: Arc<
                             motion_age_s: s.motion_age_s[..nv].to_vec(),
                             motion_rate_hz: s.motion_rate_hz[..nv].to_vec(),
                             last_compute_ms: s.last_compute_ms,
+                            latency_p50_ms: s.latency_p50_ms,
+                            latency_p99_ms: s.latency_p99_ms,
                             overruns: s.overruns,
                             running: s.running != 0,
                             received_wall_s: now,

@@ -117,6 +117,10 @@ pub struct Health {
     pub motion_age_s: Vec<f64>,
     pub motion_rate_hz: Vec<f64>,
     pub last_compute_ms: f64,
+    /// The median and the 99th percentile of a forecast's time from its newest motion sample's stamp
+    /// to its hand-over for publishing, over the daemon's newest forecasts, ms (negative: none yet).
+    pub latency_p50_ms: f64,
+    pub latency_p99_ms: f64,
     pub overruns: u64,
     /// False in the last status of a clean shutdown.
     pub running: bool,
@@ -591,6 +595,8 @@ mod tests {
             motion_age_s: vec![0.1, 0.1],
             motion_rate_hz: vec![10.0, 10.0],
             last_compute_ms: 10.0,
+            latency_p50_ms: -1.0,
+            latency_p99_ms: -1.0,
             overruns: 0,
             running: true,
             link: None,

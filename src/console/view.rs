@@ -206,9 +206,17 @@ fn forecast_lines(c: &Console, f: &Forecast, now_wall_s: f64, out: &mut Vec<(Sev
     } else {
         Severity::Alarm
     };
+    // the daemon's own figure for the whole path, from the sensor's stamp to the hand-over
+    let path = match &c.health {
+        Some(h) if h.latency_p50_ms >= 0.0 => format!(
+            " (sensor to publish {:.0} ms, p99 {:.0} ms)",
+            h.latency_p50_ms, h.latency_p99_ms
+        ),
+        _ => String::new(),
+    };
     out.push((
         s,
-        format!("Forecast: {age:.0} s old, computed in {:.0} ms", f.compute_ms),
+        format!("Forecast: {age:.0} s old, computed in {:.0} ms{path}", f.compute_ms),
     ));
     for (b, (n, h)) in c.vessels.iter().zip(&f.horizon_s).enumerate() {
         // each of heave, roll and pitch's own span, when the daemon sent them
@@ -721,6 +729,38 @@ mod tests {
     }
 
     #[test]
+    fn the_path_s_latency_is_shown_once_the_daemon_has_measured_it() {
+        let mut c = two_vessels();
+        c.on_forecast(forecast(60, 30.0, |_| 0.0, |_| 0.0));
+        let line = |c: &Console| {
+            health_lines(c, 5000.0)
+                .into_iter()
+                .find(|(_, l)| l.starts_with("Forecast:"))
+                .map(|(_, l)| l)
+        };
+        let mut h = crate::console::Health {
+            flags: vec![],
+            wave_age_s: 1.0,
+            motion_age_s: vec![0.1, 0.1],
+            motion_rate_hz: vec![10.0, 10.0],
+            last_compute_ms: 10.0,
+            latency_p50_ms: -1.0,
+            latency_p99_ms: -1.0,
+            overruns: 0,
+            running: true,
+            link: None,
+            received_wall_s: 5000.0,
+        };
+        c.on_health(h.clone());
+        let before = line(&c).unwrap();
+        assert!(!before.contains("sensor to publish"), "{before}");
+        (h.latency_p50_ms, h.latency_p99_ms) = (41.6, 57.2);
+        c.on_health(h);
+        let after = line(&c).unwrap();
+        assert!(after.ends_with("(sensor to publish 42 ms, p99 57 ms)"), "{after}");
+    }
+
+    #[test]
     fn the_ship_to_ship_link_is_shown_up_and_down() {
         let mut c = two_vessels();
         let health = |link| crate::console::Health {
@@ -729,6 +769,8 @@ mod tests {
             motion_age_s: vec![0.1, 0.1],
             motion_rate_hz: vec![10.0, 10.0],
             last_compute_ms: 10.0,
+            latency_p50_ms: -1.0,
+            latency_p99_ms: -1.0,
             overruns: 0,
             running: true,
             link,
