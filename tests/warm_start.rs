@@ -10,6 +10,7 @@ use shipcast::shell::ipc::Output;
 use shipcast::shell::ipc::wire::{ForecastHeader, Status, flags};
 use shipcast::shell::replay::{self, Record};
 use std::sync::OnceLock;
+use std::time::Instant;
 
 /// When the daemon is killed, s after the log's start, and how long it is away, s.
 const KILLED_AT_S: f64 = 660.0;
@@ -93,6 +94,14 @@ fn a_restarted_daemon_trusts_again_within_seconds_from_the_state_it_kept() {
     let before: Vec<(f64, Record)> = l.records.iter().filter(|(t, _)| *t < killed).cloned().collect();
     let after: Vec<(f64, Record)> = l.records.iter().filter(|(t, _)| *t >= back).cloned().collect();
     let (first, kept) = run(&before, None);
+    // through the state file as the daemon writes it (a full memory's samples) and reads it back
+    let file = crate::util::scratch_dir("warm-start-file").join(shipcast::shell::state::FILE_NAME);
+    let written = Instant::now();
+    shipcast::shell::state::write(&file, &kept).unwrap();
+    let write_s = written.elapsed().as_secs_f64();
+    let bytes = std::fs::metadata(&file).unwrap().len();
+    let kept = shipcast::shell::state::read(&file).unwrap().expect("the state written");
+    eprintln!("the state kept after {KILLED_AT_S} s: {bytes} bytes, written in {write_s:.3} s");
     let (warm, _) = run(&after, Some(kept));
     let (cold, _) = run(&after, None);
     let (w, c) = (first_trusted(&warm, back), first_trusted(&cold, back));
