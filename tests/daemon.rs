@@ -928,3 +928,164 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
         "{err}"
     );
 }
+
+/// The shipped demo (`config/shipcast.toml`: the moored pair, its 600 s motion memory) killed after 11
+/// minutes of data (issue 53, item 2 Show), live with the simulator at 4x: the restarted daemon takes
+/// back the state it kept (here every 10 s) and trusts a forecast within 15 s with the spans it had
+/// before; no sample is refused by its clocks and no clock steps for the restart itself.
+///
+/// Fails today (2026-12-07): the restarted daemon starts forecasting about 18 s after it is spawned
+/// ("model ready", then 8 s to the warm start's "taken back", then 9 s to "running"), and none of its
+/// 30 forecasts over the next 110 s of data is trusted (heave span 0 against 103 s before the kill)
+/// until the simulator ends. Through the engine (`warm_start`, 6 s away, the state as at the kill) the
+/// same sea is trusted 0.9 s after. Run it with `cargo test --features link -- --ignored
+/// the_demo_killed` (about 4 minutes).
+#[test]
+#[ignore = "fails today: the demo's warm restart after 11 minutes is not trusted (see its doc)"]
+fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans() {
+    use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
+    use std::io::Read;
+    /// Data seconds from the first forecast to the kill, and after the restart for its spans.
+    const KILL_AFTER_S: f64 = 660.0;
+    const SPANS_OVER_S: f64 = 60.0;
+    /// The warm start's median heave span over its first minute, at least this share of the minute's
+    /// before the kill (as `warm_start`'s, through the engine).
+    const SPAN_SHARE: f64 = 0.8;
+    let dir = crate::util::scratch_dir("daemon-demo-kill");
+    let prefix = format!("shipcast-test-{}-demo-kill", std::process::id());
+    let mut text = std::fs::read_to_string(repo("config/shipcast.toml")).unwrap();
+    let edits = [
+        (
+            "service_prefix = \"shipcast\" ",
+            format!("service_prefix = \"{prefix}\" "),
+        ),
+        ("speed = 1.0 ", "speed = 4.0 ".into()),
+        ("level = \"info\" ", "level = \"warn\" ".into()),
+        (
+            "dir = \"\"                                    # directory, relative to this file; \"\" = $STATE_DIRECTORY",
+            "dir = \"state\" # ".into(),
+        ),
+        ("every_s = 60.0", "every_s = 10.0".into()),
+    ];
+    for (from, to) in &edits {
+        assert_eq!(text.matches(from).count(), 1, "config/shipcast.toml: {from:?} once");
+        text = text.replace(from, to);
+    }
+    let cfg = dir.join("shipcast.toml");
+    std::fs::write(&cfg, crate::util::absolute_paths(&text, "vessels/pair/moored.toml")).unwrap();
+    let names = Names { prefix };
+    let mut d = daemon(&cfg);
+    let _sim = simulator(&cfg, "900", &[]);
+    let sub = ForecastSubscriber::new(&names).unwrap();
+    // (issue time, heave span end of the carrier, trusted) of every forecast read within `limit_s` wall
+    // seconds, until `done` says so
+    type Row = (f64, f64, bool);
+    let read = |limit_s: f64, out: &mut Vec<Row>, done: &dyn Fn(&[Row]) -> bool| {
+        let t = Instant::now();
+        let mut got = vec![];
+        while t.elapsed().as_secs_f64() < limit_s && !done(out) {
+            got.clear();
+            sub.wait(Duration::from_millis(100), &mut got).unwrap();
+            for r in &got {
+                if let Received::Forecast(h, _) = r {
+                    out.push((h.issue_time_s, h.series_span(2).1, h.horizon_s[0] > 0.0));
+                }
+            }
+        }
+    };
+    let t_test = Instant::now();
+    let mut first = vec![];
+    read(KILL_AFTER_S / 4.0 + 60.0, &mut first, &|f| {
+        f.last().is_some_and(|l| l.0 - f[0].0 >= KILL_AFTER_S)
+    });
+    d.kill();
+    let killed_s = first.last().expect("forecasts before the kill").0;
+    assert!(
+        killed_s - first[0].0 >= KILL_AFTER_S,
+        "only {} s of forecasts",
+        killed_s - first[0].0
+    );
+    let mut rest = vec![];
+    read(2.0, &mut rest, &|_| false);
+    let last_s = rest.iter().map(|r| r.0).fold(killed_s, f64::max);
+    // the restarted daemon logs at info (the first one at warn: its stderr is read only at the end)
+    let info = dir.join("info.toml");
+    std::fs::write(
+        &info,
+        std::fs::read_to_string(&cfg)
+            .unwrap()
+            .replace("level = \"warn\" ", "level = \"info\" "),
+    )
+    .unwrap();
+    eprintln!(
+        "killed at {:.1} s (wall), {:.1} s of data after the first forecast ({} forecasts)",
+        t_test.elapsed().as_secs_f64(),
+        killed_s - first[0].0,
+        first.len()
+    );
+    let back = spawn(&["run", "--config", info.to_str().unwrap()]);
+    let restarted = Instant::now();
+    let mut after = vec![];
+    read(15.0, &mut after, &|f| f.iter().any(|r| r.0 > last_s && r.2));
+    let warm_s = after
+        .iter()
+        .any(|r| r.0 > last_s && r.2)
+        .then(|| restarted.elapsed().as_secs_f64());
+    let back_first_s = after
+        .iter()
+        .map(|r| r.0)
+        .filter(|t| *t > last_s)
+        .fold(f64::INFINITY, f64::min);
+    read(SPANS_OVER_S / 4.0 + 30.0, &mut after, &|f| {
+        f.last().is_some_and(|l| l.0 >= back_first_s + SPANS_OVER_S)
+    });
+    eprintln!(
+        "after the restart: {} forecasts, {} trusted, until {:.1} s (wall)",
+        after.len(),
+        after.iter().filter(|r| r.2).count(),
+        t_test.elapsed().as_secs_f64()
+    );
+    let mut back = back;
+    back.kill();
+    let mut back_log = String::new();
+    back.0.stderr.take().unwrap().read_to_string(&mut back_log).unwrap();
+    let median = |rows: Vec<f64>| {
+        let mut rows = rows;
+        rows.sort_by(f64::total_cmp);
+        rows.get(rows.len() / 2).copied().unwrap_or(0.0)
+    };
+    let before = median(
+        first
+            .iter()
+            .filter(|r| r.0 >= killed_s - SPANS_OVER_S)
+            .map(|r| r.1)
+            .collect(),
+    );
+    let warm = median(
+        after
+            .iter()
+            .filter(|r| r.0 > last_s && r.0 < back_first_s + SPANS_OVER_S)
+            .map(|r| r.1)
+            .collect(),
+    );
+    eprintln!(
+        "the demo killed after {:.0} s of forecasts: a forecast trusted {warm_s:?} s (wall) after the restart; median heave span {before:.1} s over the minute before the kill, {warm:.1} s over the first minute back",
+        killed_s - first[0].0
+    );
+    assert!(
+        warm_s.is_some_and(|w| w <= 15.0),
+        "warm {warm_s:?}; the restarted daemon's log:\n{back_log}"
+    );
+    assert!(warm >= SPAN_SHARE * before, "spans {warm} against {before} before");
+    for refused in [
+        "clock stepped",
+        "ahead of its clock refused",
+        "behind its clock refused",
+        "refused, a cold start",
+    ] {
+        assert!(
+            !back_log.contains(refused),
+            "the restarted daemon's log says {refused:?}:\n{back_log}"
+        );
+    }
+}
