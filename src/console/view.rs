@@ -728,6 +728,23 @@ mod tests {
             .join("\n")
     }
 
+    /// A healthy daemon's status at wall time 5000 s, no latency measured yet, with `link`.
+    fn health(link: Option<crate::console::LinkHealth>) -> crate::console::Health {
+        crate::console::Health {
+            flags: vec![],
+            wave_age_s: 1.0,
+            motion_age_s: vec![0.1, 0.1],
+            motion_rate_hz: vec![10.0, 10.0],
+            last_compute_ms: 10.0,
+            latency_p50_ms: -1.0,
+            latency_p99_ms: -1.0,
+            overruns: 0,
+            running: true,
+            link,
+            received_wall_s: 5000.0,
+        }
+    }
+
     #[test]
     fn the_path_s_latency_is_shown_once_the_daemon_has_measured_it() {
         let mut c = two_vessels();
@@ -738,19 +755,7 @@ mod tests {
                 .find(|(_, l)| l.starts_with("Forecast:"))
                 .map(|(_, l)| l)
         };
-        let mut h = crate::console::Health {
-            flags: vec![],
-            wave_age_s: 1.0,
-            motion_age_s: vec![0.1, 0.1],
-            motion_rate_hz: vec![10.0, 10.0],
-            last_compute_ms: 10.0,
-            latency_p50_ms: -1.0,
-            latency_p99_ms: -1.0,
-            overruns: 0,
-            running: true,
-            link: None,
-            received_wall_s: 5000.0,
-        };
+        let mut h = health(None);
         c.on_health(h.clone());
         let before = line(&c).unwrap();
         assert!(!before.contains("sensor to publish"), "{before}");
@@ -763,19 +768,6 @@ mod tests {
     #[test]
     fn the_ship_to_ship_link_is_shown_up_and_down() {
         let mut c = two_vessels();
-        let health = |link| crate::console::Health {
-            flags: vec![],
-            wave_age_s: 1.0,
-            motion_age_s: vec![0.1, 0.1],
-            motion_rate_hz: vec![10.0, 10.0],
-            last_compute_ms: 10.0,
-            latency_p50_ms: -1.0,
-            latency_p99_ms: -1.0,
-            overruns: 0,
-            running: true,
-            link,
-            received_wall_s: 5000.0,
-        };
         let link_line = |c: &Console| {
             health_lines(c, 5000.0)
                 .into_iter()
