@@ -979,7 +979,7 @@ fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans(
     let sub = ForecastSubscriber::new(&names).unwrap();
     // (issue time, heave span end of the carrier, trusted) of every forecast read within `limit_s` wall
     // seconds, until `done` says so
-    type Row = (f64, f64, bool);
+    type Row = (f64, f64, bool, u32);
     let read = |limit_s: f64, out: &mut Vec<Row>, done: &dyn Fn(&[Row]) -> bool| {
         let t = Instant::now();
         let mut got = vec![];
@@ -988,7 +988,7 @@ fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans(
             sub.wait(Duration::from_millis(100), &mut got).unwrap();
             for r in &got {
                 if let Received::Forecast(h, _) = r {
-                    out.push((h.issue_time_s, h.series_span(2).1, h.horizon_s[0] > 0.0));
+                    out.push((h.issue_time_s, h.series_span(2).1, h.horizon_s[0] > 0.0, h.flags));
                 }
             }
         }
@@ -1039,11 +1039,14 @@ fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans(
     read(SPANS_OVER_S / 4.0 + 30.0, &mut after, &|f| {
         f.last().is_some_and(|l| l.0 >= back_first_s + SPANS_OVER_S)
     });
+    let flag_names = |f: u32| shipcast::shell::ipc::wire::flags::names(f);
     eprintln!(
-        "after the restart: {} forecasts, {} trusted, until {:.1} s (wall)",
+        "after the restart: {} forecasts, {} trusted, until {:.1} s (wall); the flags of the first and the last: {:?}, {:?}",
         after.len(),
         after.iter().filter(|r| r.2).count(),
-        t_test.elapsed().as_secs_f64()
+        t_test.elapsed().as_secs_f64(),
+        after.iter().find(|r| r.0 > last_s).map(|r| flag_names(r.3)),
+        after.last().map(|r| flag_names(r.3))
     );
     let mut back = back;
     back.kill();
