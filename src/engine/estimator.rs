@@ -1306,6 +1306,32 @@ mod tests {
         }
     }
 
+    /// After a gap longer than `max_gap_s` (a daemon restarted from a state kept a minute before its
+    /// kill), the start's variance is what the filter errs by sample to sample, not the gap's
+    /// extrapolation. Fails today: the first sample after the gap enters the innovation means with the
+    /// whole gap's prediction error (see issue 53's note); ignored until fixed.
+    #[test]
+    #[ignore = "fails today: a long gap's extrapolation error inflates the start's variance"]
+    fn a_long_gap_does_not_inflate_the_start_s_variance() {
+        let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(7);
+        let mut e = Estimator::new(spec(Method::Kalman), 600.0);
+        let mut feed = |e: &mut Estimator, from_s: f64, to_s: f64| {
+            for k in 0..((to_s - from_s) * 10.0) as usize {
+                let t = from_s + k as f64 * 0.1;
+                let (x, v) = noisy_wave(t, &mut rng);
+                let _ = e.push(t, x, v);
+            }
+        };
+        feed(&mut e, 0.0, 300.0);
+        let before = e.start_var(299.9).unwrap()[2];
+        feed(&mut e, 390.0, 400.0);
+        let after = e.start_var(399.9).unwrap()[2];
+        assert!(
+            after <= 2.0 * before,
+            "heave start variance {after} after a 90 s gap, {before} before"
+        );
+    }
+
     #[test]
     fn the_state_follows_the_motion_and_the_bias_comes_off() {
         let e = fed(Method::Kalman, 200.0, |_| false);
