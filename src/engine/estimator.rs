@@ -979,13 +979,14 @@ impl Estimator {
     fn take(&mut self, e: Entry) {
         // a sample after a gap counts for a second at most: one reading does not stand for the whole
         // silence; the first after a restart of the samples, for nothing (the bias is the sensor's)
-        let dt = match self.entries.back() {
+        let interval_s = match self.entries.back() {
             Some(prev) => {
                 self.moved |= prev.x != e.x || prev.v != e.v;
-                (e.time_s - prev.time_s).min(BIAS_MAX_INTERVAL_S)
+                e.time_s - prev.time_s
             }
             None => 0.0,
         };
+        let dt = interval_s.min(BIAS_MAX_INTERVAL_S);
         self.bias.add(dt, &e.x, self.spec.bias_time_s);
         if let Some(j) = &mut self.jump {
             if e.time_s - j.at_s > REVERT_WINDOW_S {
@@ -998,7 +999,6 @@ impl Estimator {
         }
         // the innovations are the filter's errors from one sample to the next: a sample after a gap
         // (longer than a bias interval) was predicted across all of it, which tells nothing of them
-        let interval_s = self.entries.back().map_or(0.0, |prev| e.time_s - prev.time_s);
         if self.entries.back().is_some() && dt > 0.0 && interval_s <= BIAS_MAX_INTERVAL_S {
             let n: [[f64; 2]; 6] =
                 std::array::from_fn(|d| [e.x[d] - e.predicted[d].m[0], e.v[d] - e.predicted[d].m[1]]);
