@@ -932,16 +932,9 @@ fn a_killed_daemon_takes_back_the_state_it_kept_and_refuses_a_corrupt_one() {
 /// The shipped demo (`config/shipcast.toml`: the moored pair, its 600 s motion memory) killed after 11
 /// minutes of data (issue 53, item 2 Show), live with the simulator at 4x: the restarted daemon takes
 /// back the state it kept (here every 10 s) and trusts a forecast within 15 s with the spans it had
-/// before; no sample is refused by its clocks and no clock steps for the restart itself.
-///
-/// Fails today (2026-12-07): the restarted daemon starts forecasting about 18 s after it is spawned
-/// ("model ready", then 8 s to the warm start's "taken back", then 9 s to "running"), and none of its
-/// 30 forecasts over the next 110 s of data is trusted (heave span 0 against 103 s before the kill)
-/// until the simulator ends. Through the engine (`warm_start`, 6 s away, the state as at the kill) the
-/// same sea is trusted 0.9 s after. Run it with `cargo test --features link -- --ignored
-/// the_demo_killed` (about 4 minutes).
+/// before; no sample is refused by its clocks and no clock steps for the restart itself. About 3
+/// minutes of wall time.
 #[test]
-#[ignore = "fails today: the demo's warm restart after 11 minutes is not trusted (see its doc)"]
 fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans() {
     use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
     use std::io::Read;

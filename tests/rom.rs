@@ -654,3 +654,59 @@ fn an_adjusted_model_is_the_model_built_with_the_change() {
             .is_err()
     );
 }
+
+/// The sampled memory's transform at many frequencies at once (one matrix product) is each
+/// frequency's own (summed in place), to rounding.
+#[test]
+fn the_kernel_at_many_frequencies_is_each_frequency_s_kernel() {
+    /// The same sums in another order.
+    const SUM_ORDER_REL_TOL: f64 = 1e-12;
+    let model = TimeModel::new(&load("config/vessels/barge/system.toml"), RomOptions::default()).unwrap();
+    let omegas: Vec<f64> = (0..9).map(|i| 0.2 + 0.3 * i as f64).collect();
+    let many = model.kernels_at(&omegas);
+    assert_eq!(many.len(), omegas.len());
+    let scale = many.iter().flat_map(|k| k.iter()).map(|v| v.norm()).fold(0.0, f64::max);
+    assert!(scale > 0.0);
+    for (w, k) in omegas.iter().zip(&many) {
+        let one = model.kernel_at(*w);
+        let off = (&one - k).iter().map(|v| v.norm()).fold(0.0, f64::max);
+        assert!(off <= SUM_ORDER_REL_TOL * scale, "K(i {w}): {off} of {scale}");
+    }
+}
+
+/// A tuned model (the built one with added roll damping and stiffness, its memory unchanged) makes the
+/// same response table from the built model's kernels as from its own; kernels of another memory (the
+/// same database at another step) are not taken.
+#[test]
+fn a_response_table_takes_the_kernels_of_its_own_memory_only() {
+    use shipcast::band::{ResponseTable, TableKernels};
+    use shipcast::rom::adjust::RowChange;
+    let sys = load("config/vessels/barge/system.toml");
+    let model = TimeModel::new(&sys, RomOptions::default()).unwrap();
+    let kernels = TableKernels::of(&model);
+    let row = model.labels.iter().position(|l| l.ends_with("roll")).unwrap();
+    let tuned = model
+        .adjusted(&[RowChange {
+            row,
+            damping: 3.0e7,
+            quadratic: 1.0e8,
+            stiffness: -2.0e7,
+        }])
+        .unwrap();
+    let own = ResponseTable::of(&tuned).unwrap();
+    assert_eq!(ResponseTable::with_kernels(&tuned, &kernels).unwrap(), own);
+    assert_ne!(own, ResponseTable::of(&model).unwrap(), "the tuning changes the table");
+    let other = TimeModel::new(
+        &sys,
+        RomOptions {
+            dt_s: 0.5 * model.opts.dt_s,
+            memory_s: Some(60.0),
+            ..model.opts
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        ResponseTable::with_kernels(&other, &kernels).unwrap(),
+        ResponseTable::of(&other).unwrap()
+    );
+}

@@ -28,22 +28,80 @@ pub struct ResponseTable {
     pub(super) delay_s: Vec<f64>,
 }
 
+/// The model's radiation kernel ([`TimeModel::kernels_at`]) at the response table's frequencies: made
+/// once per radiation memory, it serves every model that shares it (the in-situ tuning's, which
+/// `TimeModel::adjusted` makes from the model as built with its memory unchanged).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableKernels {
+    omega_rad_s: Vec<f64>,
+    kernel: Vec<nalgebra::DMatrix<num_complex::Complex64>>,
+}
+
+impl TableKernels {
+    pub fn of(model: &TimeModel) -> TableKernels {
+        let omega_rad_s = table_omegas(model);
+        TableKernels {
+            kernel: model.kernels_at(&omega_rad_s),
+            omega_rad_s,
+        }
+    }
+
+    /// Whether `model`'s kernel at the middle frequency is the one kept (to rounding): a model with
+    /// another radiation memory is caught at the cost of one frequency's transform.
+    fn probe_agrees(&self, model: &TimeModel) -> bool {
+        let i = self.omega_rad_s.len() / 2;
+        let (Some(w), Some(kept)) = (self.omega_rad_s.get(i), self.kernel.get(i)) else {
+            return false;
+        };
+        let k = model.kernel_at(*w);
+        let scale = kept.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        k.shape() == kept.shape()
+            && k.iter()
+                .zip(kept.iter())
+                .all(|(a, b)| (a - b).norm() <= KERNEL_PROBE_REL_TOL * scale)
+    }
+}
+
+/// Kernels agree to this share of their largest entry: the same memory summed in another order.
+const KERNEL_PROBE_REL_TOL: f64 = 1e-9;
+
+/// The table's frequencies: uniform over the database's excitation range.
+fn table_omegas(model: &TimeModel) -> Vec<f64> {
+    let ws = &model.db.exc_omega_rad_s;
+    let (w0, w1) = (ws[0], ws[ws.len() - 1]);
+    (0..TABLE_OMEGAS)
+        .map(|i| w0 + (w1 - w0) * i as f64 / (TABLE_OMEGAS - 1) as f64)
+        .collect()
+}
+
 impl ResponseTable {
     /// The table of a model's own response (`TimeModel::implied_rao`); a heading the database does not
     /// cover has no response (the forecast leaves its waves out too).
     pub fn of(model: &TimeModel) -> Result<ResponseTable> {
-        let ws = &model.db.exc_omega_rad_s;
-        let (w0, w1) = (ws[0], ws[ws.len() - 1]);
-        let omega_rad_s: Vec<f64> = (0..TABLE_OMEGAS)
-            .map(|i| w0 + (w1 - w0) * i as f64 / (TABLE_OMEGAS - 1) as f64)
-            .collect();
+        Self::with_kernels(model, &TableKernels::of(model))
+    }
+
+    /// [`ResponseTable::of`] with the kernels made before, for a model with the same radiation memory
+    /// (kernels of another model's frequencies or size are made afresh).
+    pub fn with_kernels(model: &TimeModel, kernels: &TableKernels) -> Result<ResponseTable> {
+        let omega_rad_s = table_omegas(model);
+        let n = model.n();
+        let fits = kernels.omega_rad_s == omega_rad_s
+            && kernels.kernel.iter().all(|k| k.shape() == (n, n))
+            && kernels.probe_agrees(model);
+        let made;
+        let kernel = if fits {
+            &kernels.kernel
+        } else {
+            made = model.kernels_at(&omega_rad_s);
+            &made
+        };
         let n_modes = model.n_modes;
         let mut rao = Vec::with_capacity(TABLE_OMEGAS * TABLE_HEADINGS * n_modes);
-        for &w in &omega_rad_s {
-            let k = model.kernel_at(w);
+        for (&w, k) in omega_rad_s.iter().zip(kernel) {
             for ib in 0..TABLE_HEADINGS {
                 let beta = TAU * ib as f64 / TABLE_HEADINGS as f64;
-                match model.implied_rao_with(&k, w, beta) {
+                match model.implied_rao_with(k, w, beta) {
                     Ok(r) => rao.extend(r),
                     Err(crate::rom::Error::Hydro(crate::hydro::Error::OutOfRange(_))) => {
                         rao.extend(std::iter::repeat_n(num_complex::Complex64::default(), n_modes))

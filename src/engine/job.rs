@@ -79,6 +79,8 @@ pub struct Computer {
     tuning: super::tune::Tuning,
     /// The model's response for the band (None: it could not be made; nothing is trusted then).
     table: Option<ResponseTable>,
+    /// The model as built's kernels for the table, which its tuned models share.
+    kernels: band::TableKernels,
     trusted_nrmse: f64,
     /// The system and options to rebuild the model at another speed, when the system file has speed
     /// terms (`speed_damping` B_U, `speed_restoring` C_UQ) or databases at several speeds (interpolated:
@@ -108,12 +110,14 @@ impl Computer {
                     .any(|v| *v != 0.0)
             });
         let n_bodies = sys.spec.bodies.len();
+        let kernels = band::TableKernels::of(&model);
         Computer {
             tuning: super::tune::Tuning::new(&model, cfg),
             base: model.clone(),
             rebuild: speed_terms.then(|| (Box::new(sys.clone()), model.opts)),
             failed_speed: None,
-            table: response_table(&model),
+            table: response_table(&model, &kernels),
+            kernels,
             trusted_nrmse: cfg.forecast.trusted_nrmse,
             model,
             fc: Forecaster::new(),
@@ -155,7 +159,8 @@ impl Computer {
             speed_m_s = want,
             "model rebuilt for the forward speed (its speed terms)"
         );
-        self.table = response_table(&model);
+        self.kernels = band::TableKernels::of(&model);
+        self.table = response_table(&model, &self.kernels);
         self.coupling = vec![None; self.n_bodies];
         self.tuning.reset(&model);
         self.base = model.clone();
@@ -414,7 +419,7 @@ impl Computer {
     /// quadratic, frequency; `Engine::roll_tuning` after `Engine::restore`).
     pub fn resume_tuning(&mut self, kept: &[[f64; 3]]) {
         if let Some(model) = self.tuning.resume(&self.base, kept) {
-            self.table = response_table(&model);
+            self.table = response_table(&model, &self.kernels);
             self.coupling = vec![None; self.n_bodies];
             self.model = model;
         }
@@ -424,7 +429,7 @@ impl Computer {
     /// does not delay a forecast; a finished round's tuning becomes the model forecasts run with.
     pub fn tune(&mut self) {
         if let Some(model) = self.tuning.work(&self.base) {
-            self.table = response_table(&model);
+            self.table = response_table(&model, &self.kernels);
             self.coupling = vec![None; self.n_bodies];
             self.model = model;
         }
@@ -432,8 +437,8 @@ impl Computer {
 }
 
 /// The model's response table for the band, or None (logged) where its equations are singular.
-fn response_table(model: &TimeModel) -> Option<ResponseTable> {
-    ResponseTable::of(model)
+fn response_table(model: &TimeModel, kernels: &band::TableKernels) -> Option<ResponseTable> {
+    ResponseTable::with_kernels(model, kernels)
         .map_err(|e| tracing::warn!("no band for the forecasts (nothing will be trusted): {e}"))
         .ok()
 }

@@ -376,9 +376,20 @@ pub fn default_duration_s(db: &HydroDb) -> f64 {
     }
 }
 
+/// Up to this many frequencies, [`transform_irf`] sums each one's weighted samples in place; more are
+/// one matrix product with the memory stacked once.
+const DIRECT_TRANSFORMS: usize = 4;
+
 /// Stacks n x n matrices as rows of an (len x n^2) matrix (column-major flattening of each).
 fn stack(ms: &[DMatrix<f64>], n: usize) -> DMatrix<f64> {
-    DMatrix::from_fn(ms.len(), n * n, |r, c| ms[r][(c % n, c / n)])
+    // row by row: each matrix read once, in its own (column-major) order
+    let mut out = DMatrix::zeros(ms.len(), n * n);
+    for (r, m) in ms.iter().enumerate() {
+        for (c, v) in m.as_slice().iter().take(n * n).enumerate() {
+            out[(r, c)] = *v;
+        }
+    }
+    out
 }
 
 fn unstack(m: &DMatrix<f64>, n: usize) -> Vec<DMatrix<f64>> {
@@ -583,6 +594,21 @@ fn psd_part(m: &DMatrix<f64>, peaks: &[f64]) -> DMatrix<f64> {
 pub fn transform_irf(irf: &Irf, omegas: &[f64], sine: bool) -> Vec<DMatrix<f64>> {
     let n = irf.k.first().map(|k| k.nrows()).unwrap_or(0);
     let t: Vec<f64> = (0..irf.k.len()).map(|m| m as f64 * irf.dt_s).collect();
+    if omegas.len() <= DIRECT_TRANSFORMS {
+        // summed in place: no stacked copy of the whole memory for a few frequencies
+        let mut row = vec![0.0; t.len()];
+        return omegas
+            .iter()
+            .map(|&w| {
+                pl_weights(&t, w, sine, &mut row);
+                let mut out = DMatrix::<f64>::zeros(n, n);
+                for (v, k) in row.iter().zip(&irf.k) {
+                    out.iter_mut().zip(k.iter()).for_each(|(o, x)| *o += v * x);
+                }
+                out
+            })
+            .collect();
+    }
     let mut weights = DMatrix::zeros(omegas.len(), t.len());
     let mut row = vec![0.0; t.len()];
     for (i, &w) in omegas.iter().enumerate() {

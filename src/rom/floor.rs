@@ -88,9 +88,9 @@ pub fn worst_curve_error(test: &RaoTable, reference: &RaoTable) -> Option<CurveE
 }
 
 /// The floor of `model`: its implied RAO ([`TimeModel::implied_rao_with`]) at every heading and
-/// frequency, each frequency's kernel computed once for every heading.
+/// frequency, the kernels computed once for every heading.
 pub fn implied_table(model: &TimeModel, omegas_rad_s: &[f64], headings_rad: &[f64]) -> Result<RaoTable> {
-    let kernels: Vec<_> = omegas_rad_s.iter().map(|w| model.kernel_at(*w)).collect();
+    let kernels = model.kernels_at(omegas_rad_s);
     headings_rad
         .iter()
         .map(|&h| {

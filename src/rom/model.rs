@@ -421,26 +421,42 @@ impl TimeModel {
     /// K(i w) = B(w) + i w (A(w) - A_inf) of the model's own radiation memory (active DOFs): the
     /// transform of the sampled K (linear between samples), or the state-space model's kernel.
     pub fn kernel_at(&self, omega_rad_s: f64) -> DMatrix<num_complex::Complex64> {
+        self.kernels_at(&[omega_rad_s])
+            .pop()
+            .unwrap_or_else(|| DMatrix::zeros(self.n(), self.n()))
+    }
+
+    /// [`TimeModel::kernel_at`] at each of `omegas_rad_s`: the sampled K's transform made for all of
+    /// them at once (one pass over the memory's samples).
+    pub fn kernels_at(&self, omegas_rad_s: &[f64]) -> Vec<DMatrix<num_complex::Complex64>> {
+        use num_complex::Complex64;
+        let n = self.n();
         match (&self.kernel, &self.irf) {
             (Kernel::StateSpace { model, .. }, _) => {
-                let k = model.kernel(omega_rad_s);
                 let nh = self.n_hydro;
-                DMatrix::from_fn(self.n(), self.n(), |i, j| {
-                    if i < nh && j < nh {
-                        k[(i, j)]
-                    } else {
-                        num_complex::Complex64::default()
-                    }
-                })
+                omegas_rad_s
+                    .iter()
+                    .map(|&w| {
+                        let k = model.kernel(w);
+                        DMatrix::from_fn(n, n, |i, j| {
+                            if i < nh && j < nh {
+                                k[(i, j)]
+                            } else {
+                                Complex64::default()
+                            }
+                        })
+                    })
+                    .collect()
             }
             (_, Some(irf)) => {
-                let c = irf::transform_irf(irf, &[omega_rad_s], false);
-                let s = irf::transform_irf(irf, &[omega_rad_s], true);
-                DMatrix::from_fn(self.n(), self.n(), |i, j| {
-                    num_complex::Complex64::new(c[0][(i, j)], -s[0][(i, j)])
-                })
+                let c = irf::transform_irf(irf, omegas_rad_s, false);
+                let s = irf::transform_irf(irf, omegas_rad_s, true);
+                c.iter()
+                    .zip(&s)
+                    .map(|(c, s)| DMatrix::from_fn(n, n, |i, j| Complex64::new(c[(i, j)], -s[(i, j)])))
+                    .collect()
             }
-            _ => DMatrix::zeros(self.n(), self.n()),
+            _ => vec![DMatrix::zeros(n, n); omegas_rad_s.len()],
         }
     }
 

@@ -218,6 +218,7 @@ pub async fn run(
     let watchdog = sd_notify::watchdog_enabled(false, &mut watchdog_usec);
     watchdog_fits(cfg.forecast.period_s, watchdog.then_some(watchdog_usec as f64 / 1e6))?;
     fits_the_wire(&sys)?;
+    let t_ready = Instant::now();
     let (model, mut engine) = build(&cfg, &sys)?;
     let names = Names {
         prefix: cfg.ipc.service_prefix.clone(),
@@ -236,7 +237,12 @@ pub async fn run(
     }
     let mut th = Threads::start(&names, computer, &stop, clock)?;
     let _ = sd_notify::notify(false, &[sd_notify::NotifyState::Ready]);
-    tracing::info!(prefix = %names.prefix, period_s = cfg.forecast.period_s, "shipcast running");
+    tracing::info!(
+        prefix = %names.prefix,
+        period_s = cfg.forecast.period_s,
+        ready_s = t_ready.elapsed().as_secs_f64(),
+        "shipcast running"
+    );
     let period_s = cfg.forecast.period_s;
     // the cadence follows the motion (`Cadence::due`); this timer only looks whether a tick is due
     // without it (no motion, or the vessels' samples never together)
