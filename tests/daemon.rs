@@ -1045,19 +1045,14 @@ fn the_demo_killed_after_11_minutes_is_trusted_again_within_15_s_with_its_spans(
     back.kill();
     let mut back_log = String::new();
     back.0.stderr.take().unwrap().read_to_string(&mut back_log).unwrap();
-    let median = |rows: Vec<f64>| {
-        let mut rows = rows;
-        rows.sort_by(f64::total_cmp);
-        rows.get(rows.len() / 2).copied().unwrap_or(0.0)
-    };
-    let before = median(
+    let before = crate::util::median(
         first
             .iter()
             .filter(|r| r.0 >= killed_s - SPANS_OVER_S)
             .map(|r| r.1)
             .collect(),
     );
-    let warm = median(
+    let warm = crate::util::median(
         after
             .iter()
             .filter(|r| r.0 > last_s && r.0 < back_first_s + SPANS_OVER_S)

@@ -7,7 +7,7 @@
 //! cuts (every connection closed, none accepted) for [`CUT_S`] and restores: a radio link lost and
 //! back, both link processes running.
 
-use crate::util::repo;
+use crate::util::{median, repo};
 use shipcast::shell::ipc::wire::{Status, flags, link_state};
 use shipcast::shell::ipc::{ForecastSubscriber, Names, Received};
 use shipcast::shell::process::Interrupting;
@@ -149,11 +149,6 @@ fn spawn(args: &[&str], log: &Path) -> Interrupting {
             .spawn()
             .expect("shipcast starts"),
     )
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 #[test]

@@ -5,7 +5,7 @@
 //! ahead; where the waves come from a sector the radar never sees, no channel that moves is trusted
 //! past what the measured state carries.
 
-use crate::util::{SimLog, simulated_with};
+use crate::util::{SimLog, median, simulated_with};
 use shipcast::shell::ipc::Output;
 use shipcast::shell::ipc::wire::ForecastHeader;
 use shipcast::shell::replay;
@@ -41,11 +41,6 @@ fn spans(log: &SimLog) -> Vec<ForecastHeader> {
     )
     .unwrap();
     out
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 #[test]

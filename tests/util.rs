@@ -212,6 +212,13 @@ pub fn parse_rao_csv(text: &str) -> Vec<RaoRow> {
         .collect()
 }
 
+/// The median of `v` (the upper of the two middle values when even); NaN when `v` is empty, so that any
+/// bound asserted on it fails.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 /// A fresh scratch directory under the system's temp dir, unique per test.
 pub fn scratch_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("shipcast-test-{}-{name}", std::process::id()));
