@@ -312,6 +312,37 @@ fn two_ship_forecasts_from_the_same_past_agree() {
     }
 }
 
+/// A forecast sums its wave force beside the radiation force its start owes (the history's, on a
+/// second thread): the same, to the bit, as the run with that force given, where the two follow each
+/// other; and a second forecast by the same forecaster again.
+#[test]
+fn a_forecast_with_a_history_is_the_same_with_its_parts_beside_each_other_or_in_turn() {
+    use shipcast::shell::scenario::{Scenario, past_options, prepare};
+    let sc = Scenario::load(&repo("config/scenarios/two-ship-moored.toml")).unwrap();
+    let sys = load_system(&sc.system).unwrap().system;
+    let model = TimeModel::new(&sys, sc.opts).unwrap();
+    let past = TimeModel::new(&sys, past_options(model.opts)).unwrap();
+    let prep = prepare(&past, &model, &sc.waves, sc.history_s).unwrap();
+    let req = prep.request(sc.length_s);
+    assert!(
+        matches!(prep.memory, shipcast::radiation::history::Memory::Convolution { len, .. } if len > 0),
+        "the scenario's start has a history to convolve"
+    );
+    let mut fc = Forecaster::new();
+    let beside = fc.forecast(&model, &req).unwrap().clone();
+    let force = fc.force_for(&model, &req).unwrap();
+    let in_turn = fc.forecast_forced(&model, &req, &force).unwrap().clone();
+    let again = fc.forecast(&model, &req).unwrap().clone();
+    for (name, other) in [("in turn", &in_turn), ("again", &again)] {
+        assert_eq!(beside.steps, other.steps);
+        assert!(
+            beside.x == other.x && beside.v == other.v,
+            "{name}: the forecasts differ"
+        );
+    }
+    assert!(beside.x.iter().any(|x| *x != 0.0));
+}
+
 /// A run of the forecaster from (x0, v0) with no past motion.
 fn run_from_rest_history(
     model: &TimeModel,

@@ -205,14 +205,14 @@ impl Computer {
         });
         // the band's start, when the forecast succeeds (else the band is nothing)
         let mut t_forecast_ms = elapsed_ms();
-        let result = {
-            let _span = tracing::debug_span!("forecast", t0_s = job.t0_s).entered();
-            self.forecast(&job)
-        }
-        .map(|(values, steps, dropped, quasi_static)| {
+        let (result, early) = self.forecast_beside_band(&job);
+        let result = result.map(|(values, steps, dropped, quasi_static)| {
             t_forecast_ms = elapsed_ms();
             let _span = tracing::debug_span!("band", t0_s = job.t0_s).entered();
-            let spread = self.band(&job, steps);
+            let spread = match early {
+                Some((at_steps, spread)) if at_steps == steps => spread,
+                _ => self.band(&job, steps),
+            };
             (values, steps, dropped, quasi_static, spread)
         });
         let compute_ms = elapsed_ms();
@@ -292,12 +292,47 @@ impl Computer {
         }
     }
 
+    /// The job's forecast ([`Self::forecast`]) and, when every vessel's motion is known, its band
+    /// computed beside it, on two cores when there are (it needs the forecast's length, not its values; with a
+    /// vessel's motion unknown the band needs the forecaster for the free responses, after it): the
+    /// band with the steps it was made for, or None.
+    #[allow(clippy::type_complexity)]
+    fn forecast_beside_band(
+        &mut self,
+        job: &Job,
+    ) -> (
+        crate::rom::Result<(Vec<f64>, usize, f64, usize)>,
+        Option<(usize, Option<band::Spread>)>,
+    ) {
+        let mut fc = std::mem::take(&mut self.fc);
+        let this = &*self;
+        let steps = (this.length_s / this.model.opts.dt_s).round() as usize;
+        let alone = !job.unknown.iter().any(|u| *u) && this.table.is_some();
+        let forecast = |fc: &mut Forecaster| {
+            let _span = tracing::debug_span!("forecast", t0_s = job.t0_s).entered();
+            this.forecast(fc, job)
+        };
+        let out = if alone {
+            let (result, spread) = rayon::join(
+                || forecast(&mut fc),
+                || {
+                    let _span = tracing::debug_span!("band", t0_s = job.t0_s).entered();
+                    this.spread_with(job, steps, &this.spread_options(job))
+                },
+            );
+            (result, Some((steps, spread)))
+        } else {
+            (forecast(&mut fc), None)
+        };
+        self.fc = fc;
+        out
+    }
+
     /// The job's forecast: its displacements series-major, the steps, the wave variance left out and
     /// the quasi-static components.
     #[allow(clippy::type_complexity)]
-    fn forecast(&mut self, job: &Job) -> crate::rom::Result<(Vec<f64>, usize, f64, usize)> {
+    fn forecast(&self, fc: &mut Forecaster, job: &Job) -> crate::rom::Result<(Vec<f64>, usize, f64, usize)> {
         let (model, n_bodies) = (&self.model, self.n_bodies);
-        let fc = &mut self.fc;
         let drift = (self.drift_window_s > 0.0)
             .then(|| {
                 crate::rom::drift::slow_velocity(
@@ -334,13 +369,7 @@ impl Computer {
     /// With a vessel started from rest for want of its motion, the others' band holds what its
     /// unknown start does to them through the coupling ([`band::coupled_var`]).
     fn band(&mut self, job: &Job, steps: usize) -> Option<band::Spread> {
-        let mut opts = SpreadOptions {
-            model_error: job.model_error.clone(),
-            trusted_nrmse: self.trusted_nrmse,
-            start_var: job.start_var.clone(),
-            start_offset: job.start_offset.clone(),
-            coupled_var: vec![],
-        };
+        let mut opts = self.spread_options(job);
         let alone = self.spread_with(job, steps, &opts)?;
         if !job.unknown.iter().any(|u| *u) {
             return Some(alone);
@@ -382,6 +411,17 @@ impl Computer {
             .collect();
         opts.coupled_var = band::coupled_var(&responses, self.n_bodies, steps);
         self.spread_with(job, steps, &opts)
+    }
+
+    /// The band's options for a job, the coupled variance none.
+    fn spread_options(&self, job: &Job) -> SpreadOptions {
+        SpreadOptions {
+            model_error: job.model_error.clone(),
+            trusted_nrmse: self.trusted_nrmse,
+            start_var: job.start_var.clone(),
+            start_offset: job.start_offset.clone(),
+            coupled_var: vec![],
+        }
     }
 
     /// [`band::spread`] of a job with `opts`.

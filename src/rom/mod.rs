@@ -34,6 +34,7 @@ pub mod dense;
 pub mod drift;
 pub mod floor;
 pub mod forecast;
+mod known;
 pub mod model;
 pub mod outputs;
 pub mod passivity;
