@@ -209,10 +209,7 @@ impl Computer {
         let result = result.map(|(values, steps, dropped, quasi_static)| {
             t_forecast_ms = elapsed_ms();
             let _span = tracing::debug_span!("band", t0_s = job.t0_s).entered();
-            let spread = match early {
-                Some((at_steps, spread)) if at_steps == steps => spread,
-                _ => self.band(&job, steps),
-            };
+            let spread = early.unwrap_or_else(|| self.band(&job, steps));
             (values, steps, dropped, quasi_static, spread)
         });
         let compute_ms = elapsed_ms();
@@ -295,18 +292,18 @@ impl Computer {
     /// The job's forecast ([`Self::forecast`]) and, when every vessel's motion is known, its band
     /// computed beside it, on two cores when there are (it needs the forecast's length, not its values; with a
     /// vessel's motion unknown the band needs the forecaster for the free responses, after it): the
-    /// band with the steps it was made for, or None.
+    /// band, or None when it is made after the forecast.
     #[allow(clippy::type_complexity)]
     fn forecast_beside_band(
         &mut self,
         job: &Job,
     ) -> (
         crate::rom::Result<(Vec<f64>, usize, f64, usize)>,
-        Option<(usize, Option<band::Spread>)>,
+        Option<Option<band::Spread>>,
     ) {
         let mut fc = std::mem::take(&mut self.fc);
         let this = &*self;
-        let steps = (this.length_s / this.model.opts.dt_s).round() as usize;
+        let steps = crate::rom::forecast::steps_of(&this.model, this.length_s);
         let alone = !job.unknown.iter().any(|u| *u) && this.table.is_some();
         let forecast = |fc: &mut Forecaster| {
             let _span = tracing::debug_span!("forecast", t0_s = job.t0_s).entered();
@@ -320,7 +317,7 @@ impl Computer {
                     this.spread_with(job, steps, &this.spread_options(job))
                 },
             );
-            (result, Some((steps, spread)))
+            (result, Some(spread))
         } else {
             (forecast(&mut fc), None)
         };

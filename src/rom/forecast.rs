@@ -19,6 +19,11 @@ pub const MAX_FORECAST_LENGTH_S: f64 = 3600.0;
 /// that long is 70 MB.
 pub const MAX_FORECAST_STEPS: usize = 360_000;
 
+/// The steps of a forecast `length_s` long on `model`'s step (the nearest whole number).
+pub fn steps_of(model: &TimeModel, length_s: f64) -> usize {
+    (length_s / model.opts.dt_s).round() as usize
+}
+
 /// What a forecast needs, for the active DOFs of the model (in `model.active` order).
 #[derive(Debug, Clone, Copy)]
 pub struct ForecastRequest<'a> {
@@ -236,7 +241,7 @@ impl Forecaster {
                 "forecast length {length_s} s: must be in (0, {MAX_FORECAST_LENGTH_S}] s"
             )));
         }
-        let steps = (length_s / dt).round() as usize;
+        let steps = steps_of(model, length_s);
         if steps > MAX_FORECAST_STEPS {
             return Err(Error::Input(format!(
                 "forecast length {length_s} s at a {dt} s step is {steps} steps, more than {MAX_FORECAST_STEPS}"
@@ -271,7 +276,7 @@ impl Forecaster {
     /// tuning) need not sum the waves again.
     pub fn forecast_forced(&mut self, model: &TimeModel, req: &ForecastRequest, force: &[f64]) -> Result<&Forecast> {
         let n = model.n();
-        let steps = (req.length_s / model.opts.dt_s).round() as usize;
+        let steps = steps_of(model, req.length_s);
         if force.len() != (steps + 1) * n {
             return Err(Error::Input(format!(
                 "a given wave force of {} values for {} steps of {n} states",
@@ -379,7 +384,7 @@ impl Forecaster {
     /// The wave force a request implies at t0 + k dt, k = 0..steps (k-major, active DOFs), through the
     /// same code as a forecast.
     pub fn force_for(&mut self, model: &TimeModel, req: &ForecastRequest) -> Result<Vec<f64>> {
-        let steps = (req.length_s / model.opts.dt_s).round() as usize;
+        let steps = steps_of(model, req.length_s);
         self.wave_force(model, req.waves, steps, req.ramp_s, req.track)?;
         Ok(self.force.clone())
     }
