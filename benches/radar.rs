@@ -2,14 +2,15 @@
 //! radar: 15.6 m cells, one scan every 2 s), a short-crested JONSWAP sea (Hs 2 m, Tp 9 s, 200
 //! components) with 5 cm noise: from the newest three snapshots, and one scan's update at the default
 //! window (a 200 m blind zone, NaN, as the default radar's; as many scans as
-//! `waves::window::window_scans` asks of the field, at most `forecast.radar_snapshots`' default 48).
+//! `waves::window::window_scans` asks of the field, at most `forecast.radar_snapshots`' default 48),
+//! started from the window before's fit as the daemon's are, and cold (the first window).
 //! A radar processor inverts once a scan: the bench's median must stay within a fifth of the 2 s scan on
 //! one core. Setup outside the timing.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use shipcast::waves::field::{Region, WaveField};
-use shipcast::waves::observe::{Grid, GridFrame, GridOptions, from_grids, from_scans};
+use shipcast::waves::observe::{Grid, GridFrame, GridOptions, from_grids, from_scans, from_scans_after};
 use shipcast::waves::sea::{SeaState, Spreading, realize_all};
 use shipcast::waves::window::window_scans;
 use std::hint::black_box;
@@ -83,7 +84,17 @@ fn benches(c: &mut Criterion) {
     let n = window_scans(&first, 2.0, stack.len());
     let window = &stack[stack.len() - n..];
     eprintln!("radar: the default window holds {n} scans");
+    // the daemon's steady state: the window before's fit is at hand
+    let (_, prior) = from_scans_after(&stack[stack.len() - n - 1..stack.len() - 1], frame, &opts, None).unwrap();
     g.bench_function("scan_update_default_window", |b| {
+        b.iter(|| {
+            from_scans_after(black_box(window), frame, &opts, Some(&prior))
+                .map(|(f, _)| f.components.len())
+                .unwrap()
+        })
+    });
+    // the first window, or one after the grid changed: the fill's passes from cold
+    g.bench_function("scan_update_default_window_cold", |b| {
         b.iter(|| {
             from_scans(black_box(window), frame, &opts)
                 .map(|f| f.components.len())

@@ -14,7 +14,7 @@
 use crate::hydro::VesselSystem;
 use crate::rom::{self, Forecast, Forecaster, RomOptions, TimeModel, Track};
 use crate::waves::field::{Region, WaveField};
-use crate::waves::observe::{Grid, GridFrame, GridOptions, from_scans};
+use crate::waves::observe::{Grid, GridFrame, GridOptions, ScanFit, from_scans_after};
 use crate::waves::sea::{SeaState, realize_all};
 use crate::waves::window::{MIN_WINDOW_SCANS, regrid, window_scans};
 use rand::{Rng, SeedableRng};
@@ -151,6 +151,8 @@ pub struct Simulation {
     /// the processor's next inversion takes (`waves::window::window_scans` of its last field).
     grids: Vec<Grid>,
     window: usize,
+    /// The processor's last window's fit, which its next starts from.
+    fit: Option<ScanFit>,
     /// Reference points of the bodies in the system frame, m.
     body_xy_m: Vec<[f64; 2]>,
     /// The radar map's centre, earth frame, m.
@@ -220,6 +222,7 @@ impl Simulation {
             truth,
             spec,
             grids: vec![],
+            fit: None,
             window,
         })
     }
@@ -435,16 +438,18 @@ impl Simulation {
             mean_direction_rad: None,
             region: None,
         };
-        // the processor's own inversion of its window's newest scans, the cells it does not see taken
-        // as zero; its region what they saw (the blind zone, a masked sector, the window's length)
+        // the processor's own inversion of its window's newest scans, the cells it does not see filled
+        // from its last window's fit; its region what they saw (the blind zone, a masked sector, the
+        // window's length)
         let used = self.window.clamp(1, most).min(self.grids.len());
         let frame = GridFrame {
             origin_m: [0.0, 0.0],
             orientation_rad: 0.0,
         };
-        let f = from_scans(&self.grids[self.grids.len() - used..], frame, &opts)
-            .ok()?
-            .pruned(PROCESSOR_VARIANCE_KEPT);
+        let (f, fit) =
+            from_scans_after(&self.grids[self.grids.len() - used..], frame, &opts, self.fit.as_ref()).ok()?;
+        self.fit = Some(fit);
+        let f = f.pruned(PROCESSOR_VARIANCE_KEPT);
         self.window = window_scans(&f, r.period_s, most);
         Some(f)
     }

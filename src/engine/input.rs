@@ -141,6 +141,7 @@ impl Engine {
         if stepped {
             self.state_flags |= flags::CLOCK_STEP;
             self.scans.clear();
+            self.radar_fit = None;
         }
         // a sequence shares one grid at increasing times: another grid of the same lattice (a map
         // re-centred on the ship by whole cells) takes the earlier scans moved onto it; any other
@@ -193,8 +194,9 @@ impl Engine {
                 origin_m: [0.0, 0.0],
                 orientation_rad: 0.0,
             });
-        match crate::waves::observe::from_scans(&grids, frame, &self.radar_options) {
-            Ok(f) => {
+        match crate::waves::observe::from_scans_after(&grids, frame, &self.radar_options, self.radar_fit.as_ref()) {
+            Ok((f, fit)) => {
+                self.radar_fit = Some(fit);
                 if !stepped && self.refuse_implausible(&f, "radar scans' field") {
                     return;
                 }

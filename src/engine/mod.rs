@@ -145,9 +145,10 @@ pub struct Engine {
     last_frame: Option<(f64, [f64; 2], [f64; 2])>,
     /// The newest radar scans of one grid (at most `forecast.radar_snapshots`), how many of the newest
     /// the next inversion takes (`waves::window::window_scans` of the last field), and how they are
-    /// inverted (the database's frequency band).
+    /// inverted (the database's frequency band); the last inversion's fit, which the next starts from.
     scans: std::collections::VecDeque<message::Scan>,
     radar_window: usize,
+    radar_fit: Option<crate::waves::observe::ScanFit>,
     radar_options: crate::waves::observe::GridOptions,
     /// Each vessel's motion estimator (its kept window of samples).
     hist: Vec<Estimator>,
@@ -240,6 +241,7 @@ impl Engine {
             last_frame: None,
             scans: std::collections::VecDeque::new(),
             radar_window: cfg.forecast.radar_snapshots as usize,
+            radar_fit: None,
             radar_options: {
                 let (lo, hi) = model.db.omega_range();
                 crate::waves::observe::GridOptions {

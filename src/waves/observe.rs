@@ -11,17 +11,22 @@
 //!
 //! Radar scans ([`from_scans`]): snapshots whose cells may be invalid (NaN: the blind zone around the
 //! antenna, cells shadowed behind crests, a sector masked by the superstructure, beyond the range),
-//! on a grid that may be turned in the earth frame. Each snapshot's invalid cells are taken as zero
-//! (as outside a radar's disc), and the field's region is what the cells valid in any snapshot
-//! covered ([`Region::Coverage`]).
+//! on a grid that may be turned in the earth frame. Each snapshot's invalid cells are filled from the
+//! field fitted to the valid ones ([`fill`]: what the older scans saw of the water in the blind zone
+//! now), and the field's region is what the cells valid in any snapshot covered
+//! ([`Region::Coverage`]).
 //!
 //! Probe: the record's FFT (the seed paper's method), long-crested along a given direction, amplitudes
 //! referred to the probe and the record's last sample.
 
 use super::field::{COVERAGE_SECTORS, Error, FieldComponent, Region, Result, WaveField, coverage_sector_of};
 use num_complex::Complex64;
-use rustfft::FftPlanner;
+use rustfft::{FftDirection, FftPlanner};
 use std::f64::consts::PI;
+
+pub mod fill;
+use fill::masked_fit;
+pub use fill::{FILL_PASSES, ScanFit};
 
 /// One gridded elevation snapshot: `values[iy * x_m.len() + ix]` at `(x_m[ix], y_m[iy])`, earth frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,58 +80,117 @@ fn uniform_spacing(v: &[f64], name: &str, snap: usize) -> Result<f64> {
 /// Turns one or more snapshots of the same grid into a field referred to the grid's centre and the last
 /// snapshot's time.
 pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
-    let Some(first) = grids.first() else {
-        return Err(Error::Invalid("no grid snapshot given".into()));
-    };
-    if !(opts.omega_min_rad_s > 0.0 && opts.omega_max_rad_s > opts.omega_min_rad_s) {
-        return Err(Error::Invalid(format!(
-            "frequency band {}..{} rad/s: must be positive and increasing",
-            opts.omega_min_rad_s, opts.omega_max_rad_s
-        )));
+    let lattice = Lattice::of(grids, opts)?;
+    let fits = lattice.fit(grids, &spectra_2d(grids, lattice.nx, lattice.ny), opts);
+    lattice.field(grids, &fits, opts)
+}
+
+/// A sequence of snapshots on one uniform grid, checked: its size, its extent and where it lies.
+struct Lattice {
+    nx: usize,
+    ny: usize,
+    /// The grid's extent along x and y (cells times spacing), m.
+    l_m: [f64; 2],
+    /// The grid's centre and its first cell, m.
+    centre_m: [f64; 2],
+    origin_m: [f64; 2],
+    /// The last snapshot's time, which the fit refers to, s.
+    t_ref_s: f64,
+}
+
+/// One wavenumber bin's fit: its complex values over the snapshots are P exp(+i w (t - t_ref)) +
+/// Q exp(-i w (t - t_ref)).
+struct BinFit {
+    /// The bin's index in a snapshot's spectrum.
+    index: usize,
+    k_rad_m: [f64; 2],
+    omega_rad_s: f64,
+    p: Complex64,
+    q: Complex64,
+}
+
+impl Lattice {
+    /// The lattice of `grids`, refused with the snapshot and the axis when it is not one uniform grid
+    /// sampled at increasing times, or when `opts` cannot invert it.
+    fn of(grids: &[Grid], opts: &GridOptions) -> Result<Lattice> {
+        let Some(first) = grids.first() else {
+            return Err(Error::Invalid("no grid snapshot given".into()));
+        };
+        if !(opts.omega_min_rad_s > 0.0 && opts.omega_max_rad_s > opts.omega_min_rad_s) {
+            return Err(Error::Invalid(format!(
+                "frequency band {}..{} rad/s: must be positive and increasing",
+                opts.omega_min_rad_s, opts.omega_max_rad_s
+            )));
+        }
+        let (nx, ny) = (first.x_m.len(), first.y_m.len());
+        let dx = uniform_spacing(&first.x_m, "x_m", 0)?;
+        let dy = uniform_spacing(&first.y_m, "y_m", 0)?;
+        check_snapshots(grids, nx, ny)?;
+        if grids.len() == 1 && opts.mean_direction_rad.is_none() {
+            return Err(Error::Invalid(
+                "a single snapshot cannot tell opposite directions apart: give the mean direction or a sequence".into(),
+            ));
+        }
+        Ok(Lattice {
+            nx,
+            ny,
+            l_m: [dx * nx as f64, dy * ny as f64],
+            centre_m: [
+                0.5 * (first.x_m[0] + first.x_m[nx - 1]),
+                0.5 * (first.y_m[0] + first.y_m[ny - 1]),
+            ],
+            origin_m: [first.x_m[0], first.y_m[0]],
+            t_ref_s: grids[grids.len() - 1].time_s,
+        })
     }
-    let (nx, ny) = (first.x_m.len(), first.y_m.len());
-    let dx = uniform_spacing(&first.x_m, "x_m", 0)?;
-    let dy = uniform_spacing(&first.y_m, "y_m", 0)?;
-    check_snapshots(grids, nx, ny)?;
-    if grids.len() == 1 && opts.mean_direction_rad.is_none() {
-        return Err(Error::Invalid(
-            "a single snapshot cannot tell opposite directions apart: give the mean direction or a sequence".into(),
-        ));
+
+    /// Every bin of one half-plane inside the band fitted from the snapshots' `spectra`; the mean and
+    /// the Nyquist lines (their direction is ambiguous), and the bins `separate` cannot split, left out.
+    fn fit(&self, grids: &[Grid], spectra: &[Vec<Complex64>], opts: &GridOptions) -> Vec<BinFit> {
+        let (nx, ny) = (self.nx, self.ny);
+        let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
+        let omega_of = |k: f64| match opts.depth_m {
+            Some(h) => (opts.g_m_s2 * k * (k * h).tanh()).sqrt(),
+            None => (opts.g_m_s2 * k).sqrt(),
+        };
+        let mut fits = vec![];
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let (mx, my) = (signed(ix, nx), signed(iy, ny));
+                if (my < 0 || (my == 0 && mx <= 0)) || (nx % 2 == 0 && ix == nx / 2) || (ny % 2 == 0 && iy == ny / 2) {
+                    continue;
+                }
+                let (kx, ky) = (2.0 * PI * mx as f64 / self.l_m[0], 2.0 * PI * my as f64 / self.l_m[1]);
+                let w = omega_of(kx.hypot(ky));
+                if w < opts.omega_min_rad_s || w > opts.omega_max_rad_s {
+                    continue;
+                }
+                let index = iy * nx + ix;
+                let c: Vec<Complex64> = spectra.iter().map(|s| s[index]).collect();
+                let Some((p, q)) = separate(grids, &c, w, self.t_ref_s, opts.mean_direction_rad, [kx, ky]) else {
+                    continue;
+                };
+                fits.push(BinFit {
+                    index,
+                    k_rad_m: [kx, ky],
+                    omega_rad_s: w,
+                    p,
+                    q,
+                });
+            }
+        }
+        fits
     }
-    let t_ref = grids[grids.len() - 1].time_s;
-    let n = (nx * ny) as f64;
-    let spectra = spectra_2d(grids, nx, ny);
-    let (lx, ly) = (dx * nx as f64, dy * ny as f64);
-    let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
-    let centre = [
-        0.5 * (first.x_m[0] + first.x_m[nx - 1]),
-        0.5 * (first.y_m[0] + first.y_m[ny - 1]),
-    ];
-    let origin = [first.x_m[0], first.y_m[0]];
-    let omega_of = |k: f64| match opts.depth_m {
-        Some(h) => (opts.g_m_s2 * k * (k * h).tanh()).sqrt(),
-        None => (opts.g_m_s2 * k).sqrt(),
-    };
-    let mut comps = vec![];
-    for iy in 0..ny {
-        for ix in 0..nx {
-            let (mx, my) = (signed(ix, nx), signed(iy, ny));
-            // one half-plane; skip the mean and the Nyquist lines (their direction is ambiguous)
-            if (my < 0 || (my == 0 && mx <= 0)) || (nx % 2 == 0 && ix == nx / 2) || (ny % 2 == 0 && iy == ny / 2) {
-                continue;
-            }
-            let (kx, ky) = (2.0 * PI * mx as f64 / lx, 2.0 * PI * my as f64 / ly);
-            let k = kx.hypot(ky);
-            let w = omega_of(k);
-            if w < opts.omega_min_rad_s || w > opts.omega_max_rad_s {
-                continue;
-            }
-            let c: Vec<Complex64> = spectra.iter().map(|s| s[iy * nx + ix]).collect();
-            let Some((p, q)) = separate(grids, &c, w, t_ref, opts.mean_direction_rad, [kx, ky]) else {
-                continue;
-            };
+
+    /// The field of `fits`: each bin's two waves, amplitudes referred to the grid's centre.
+    fn field(&self, grids: &[Grid], fits: &[BinFit], opts: &GridOptions) -> Result<WaveField> {
+        let n = (self.nx * self.ny) as f64;
+        let (centre, origin) = (self.centre_m, self.origin_m);
+        let mut comps = vec![];
+        for b in fits {
+            let [kx, ky] = b.k_rad_m;
             // amplitudes at the grid origin, then at the centre
-            for (coef, sign, conj) in [(p, -1.0, false), (q, 1.0, true)] {
+            for (coef, sign, conj) in [(b.p, -1.0, false), (b.q, 1.0, true)] {
                 if coef.norm() == 0.0 {
                     continue;
                 }
@@ -137,27 +201,27 @@ pub fn from_grids(grids: &[Grid], opts: &GridOptions) -> Result<WaveField> {
                 let (dxk, dyk) = (sign * kx, sign * ky);
                 let shift = dxk * (centre[0] - origin[0]) + dyk * (centre[1] - origin[1]);
                 comps.push(FieldComponent {
-                    omega_rad_s: w,
+                    omega_rad_s: b.omega_rad_s,
                     direction_rad: dyk.atan2(dxk),
                     amplitude_m: a * Complex64::from_polar(1.0, -shift),
                 });
             }
         }
+        let region = opts.region.unwrap_or(Region::Disc {
+            centre_m: centre,
+            radius_m: 0.5 * self.l_m[0].min(self.l_m[1]),
+        });
+        let f = WaveField {
+            components: comps,
+            reference_m: centre,
+            time_s: grids[grids.len() - 1].time_s,
+            g_m_s2: opts.g_m_s2,
+            depth_m: opts.depth_m,
+            region,
+        };
+        f.validate()?;
+        Ok(f)
     }
-    let region = opts.region.unwrap_or(Region::Disc {
-        centre_m: centre,
-        radius_m: 0.5 * lx.min(ly),
-    });
-    let f = WaveField {
-        components: comps,
-        reference_m: centre,
-        time_s: t_ref,
-        g_m_s2: opts.g_m_s2,
-        depth_m: opts.depth_m,
-        region,
-    };
-    f.validate()?;
-    Ok(f)
 }
 
 /// Where a radar scan's grid lies in the earth frame: its snapshots' `x_m` and `y_m` are along the
@@ -186,10 +250,25 @@ pub const SEPARATION_FLOOR: f64 = 0.1;
 /// The least share of each snapshot's cells that must be valid.
 pub const MIN_VALID_SHARE: f64 = 0.05;
 
-/// A field from radar scans with invalid (NaN) cells on a grid in `frame` ([`from_grids`] on the
-/// valid cells, the rest taken as zero; the region what the valid cells covered, seen from the grid's
-/// centre; directions and reference point turned into the earth frame).
+/// A field from radar scans with invalid (NaN) cells on a grid in `frame` ([`from_grids`] of the scans,
+/// the invalid cells filled from the fit to the valid ones by [`FILL_PASSES`] passes ([`fill`]); the
+/// region what the valid cells covered, seen from the grid's centre; directions and reference point
+/// turned into the earth frame).
 pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Result<WaveField> {
+    from_scans_after(grids, frame, opts, None).map(|(f, _)| f)
+}
+
+/// [`from_scans`] started from the fit of the window before (`prior`, from the same lattice, the
+/// grid's origin moved by whole cells at most): the scans' unseen cells are filled from it and fitted
+/// once, which tracks the fit to the seen cells as the window slides at a pass's cost. Without a prior
+/// (or one from another lattice) the window is fitted with [`FILL_PASSES`] passes. Also returns this
+/// window's fit, for the next.
+pub fn from_scans_after(
+    grids: &[Grid],
+    frame: GridFrame,
+    opts: &GridOptions,
+    prior: Option<&ScanFit>,
+) -> Result<(WaveField, ScanFit)> {
     let Some(first) = grids.first() else {
         return Err(Error::Invalid("no radar scan given".into()));
     };
@@ -221,13 +300,16 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
             ..g.clone()
         })
         .collect();
-    let local = from_grids(
+    let (local, fit) = masked_fit(
         &zeroed,
+        grids,
+        frame,
         &GridOptions {
             mean_direction_rad: opts.mean_direction_rad.map(|d| d - frame.orientation_rad),
             region: None,
             ..*opts
         },
+        prior,
     )?;
     // the coverage, seen from the grid's centre
     let centre_local = local.reference_m;
@@ -272,7 +354,7 @@ pub fn from_scans(grids: &[Grid], frame: GridFrame, opts: &GridOptions) -> Resul
         ..local
     };
     f.validate()?;
-    Ok(f)
+    Ok((f, fit))
 }
 
 /// Every snapshot on the first one's grid, with `nx` x `ny` finite values, at finite increasing times.
@@ -310,30 +392,53 @@ fn check_snapshots(grids: &[Grid], nx: usize, ny: usize) -> Result<()> {
 /// The 2-D FFT of each snapshot less its mean (rows, then columns).
 fn spectra_2d(grids: &[Grid], nx: usize, ny: usize) -> Vec<Vec<Complex64>> {
     let n = (nx * ny) as f64;
-    let mut planner = FftPlanner::new();
-    let fx = planner.plan_fft_forward(nx);
-    let fy = planner.plan_fft_forward(ny);
+    let fft = Fft2d::new(nx, ny, FftDirection::Forward);
     grids
         .iter()
         .map(|g| {
             let mean = g.values.iter().sum::<f64>() / n;
             let mut c: Vec<Complex64> = g.values.iter().map(|v| Complex64::new(v - mean, 0.0)).collect();
-            for row in c.chunks_exact_mut(nx) {
-                fx.process(row);
-            }
-            let mut col = vec![Complex64::default(); ny];
-            for ix in 0..nx {
-                for iy in 0..ny {
-                    col[iy] = c[iy * nx + ix];
-                }
-                fy.process(&mut col);
-                for iy in 0..ny {
-                    c[iy * nx + ix] = col[iy];
-                }
-            }
+            fft.process(&mut c);
             c
         })
         .collect()
+}
+
+/// A 2-D FFT of `nx` x `ny` values stored by rows (unnormalized, as rustfft's).
+struct Fft2d {
+    nx: usize,
+    ny: usize,
+    rows: std::sync::Arc<dyn rustfft::Fft<f64>>,
+    columns: std::sync::Arc<dyn rustfft::Fft<f64>>,
+}
+
+impl Fft2d {
+    fn new(nx: usize, ny: usize, direction: FftDirection) -> Fft2d {
+        let mut planner = FftPlanner::new();
+        Fft2d {
+            nx,
+            ny,
+            rows: planner.plan_fft(nx, direction),
+            columns: planner.plan_fft(ny, direction),
+        }
+    }
+
+    fn process(&self, c: &mut [Complex64]) {
+        let (nx, ny) = (self.nx, self.ny);
+        for row in c.chunks_exact_mut(nx) {
+            self.rows.process(row);
+        }
+        let mut col = vec![Complex64::default(); ny];
+        for ix in 0..nx {
+            for iy in 0..ny {
+                col[iy] = c[iy * nx + ix];
+            }
+            self.columns.process(&mut col);
+            for iy in 0..ny {
+                c[iy * nx + ix] = col[iy];
+            }
+        }
+    }
 }
 
 /// The spectra `c` (one per snapshot) of wavenumber `k_rad_m` split into the waves travelling along it
@@ -453,7 +558,7 @@ pub fn from_probe(
 mod tests {
     use super::*;
 
-    fn grid_of(field: &WaveField, n: usize, d: f64, t: f64) -> Grid {
+    pub(super) fn grid_of(field: &WaveField, n: usize, d: f64, t: f64) -> Grid {
         let x: Vec<f64> = (0..n).map(|i| -0.5 * d * n as f64 + d * i as f64).collect();
         let mut pts = Vec::with_capacity(n * n);
         for yy in &x {
