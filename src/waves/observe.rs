@@ -148,7 +148,6 @@ impl Lattice {
     /// the Nyquist lines (their direction is ambiguous), and the bins `separate` cannot split, left out.
     fn fit(&self, grids: &[Grid], spectra: &[Vec<Complex64>], opts: &GridOptions) -> Vec<BinFit> {
         let (nx, ny) = (self.nx, self.ny);
-        let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
         let omega_of = |k: f64| match opts.depth_m {
             Some(h) => (opts.g_m_s2 * k * (k * h).tanh()).sqrt(),
             None => (opts.g_m_s2 * k).sqrt(),
@@ -402,6 +401,11 @@ fn spectra_2d(grids: &[Grid], nx: usize, ny: usize) -> Vec<Vec<Complex64>> {
             c
         })
         .collect()
+}
+
+/// The signed wavenumber index of FFT bin `i` of `n` (0, 1 .. n / 2, then -(n - i)).
+fn signed(i: usize, n: usize) -> i64 {
+    if i <= n / 2 { i as i64 } else { i as i64 - n as i64 }
 }
 
 /// A 2-D FFT of `nx` x `ny` values stored by rows (unnormalized, as rustfft's).

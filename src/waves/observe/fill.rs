@@ -4,7 +4,7 @@
 //! to the seen cells alone (the EM algorithm for missing data). A window may start from the fit of the
 //! window before ([`ScanFit`]). Conventions as in [`super::super::field`]; grids as in [`super`].
 
-use super::{Fft2d, Grid, GridFrame, GridOptions, Lattice, Result, WaveField, spectra_2d};
+use super::{Fft2d, Grid, GridFrame, GridOptions, Lattice, Result, WaveField, signed, spectra_2d};
 use num_complex::Complex64;
 use rustfft::FftDirection;
 use std::f64::consts::PI;
@@ -68,7 +68,6 @@ impl ScanFit {
             return None;
         }
         let (mx0, my0) = (cells[0].round() as i64, cells[1].round() as i64);
-        let signed = |i: usize, n: usize| if i <= n / 2 { i as i64 } else { i as i64 - n as i64 };
         out.fill(Complex64::default());
         for &(index, w, p, q) in &self.bins {
             let (ix, iy) = (index % self.nx, index / self.nx);
