@@ -100,6 +100,7 @@ struct Lattice {
 
 /// One wavenumber bin's fit: its complex values over the snapshots are P exp(+i w (t - t_ref)) +
 /// Q exp(-i w (t - t_ref)).
+#[derive(Debug, Clone, PartialEq)]
 struct BinFit {
     /// The bin's index in a snapshot's spectrum.
     index: usize,

@@ -4,7 +4,7 @@
 //! to the seen cells alone (the EM algorithm for missing data). A window may start from the fit of the
 //! window before ([`ScanFit`]). Conventions as in [`super::super::field`]; grids as in [`super`].
 
-use super::{Fft2d, Grid, GridFrame, GridOptions, Lattice, Result, WaveField, signed, spectra_2d};
+use super::{BinFit, Fft2d, Grid, GridFrame, GridOptions, Lattice, Result, WaveField, signed, spectra_2d};
 use num_complex::Complex64;
 use rustfft::FftDirection;
 use std::f64::consts::PI;
@@ -30,8 +30,7 @@ pub struct ScanFit {
     spacing_m: [f64; 2],
     /// The time the bins' values refer to, s.
     t_ref_s: f64,
-    /// (index, omega, P, Q) per bin, as [`BinFit`].
-    bins: Vec<(usize, f64, Complex64, Complex64)>,
+    bins: Vec<BinFit>,
 }
 
 /// How far from a whole number of cells a prior's grid may lie from the window's and still be its
@@ -69,16 +68,16 @@ impl ScanFit {
         }
         let (mx0, my0) = (cells[0].round() as i64, cells[1].round() as i64);
         out.fill(Complex64::default());
-        for &(index, w, p, q) in &self.bins {
-            let (ix, iy) = (index % self.nx, index / self.nx);
+        for b in &self.bins {
+            let (ix, iy) = (b.index % self.nx, b.index / self.nx);
             // a grid moved by whole cells sees the same wave at the bin's phase times exp(+i k . shift)
             let turn = 2.0
                 * PI
                 * (signed(ix, self.nx) as f64 * mx0 as f64 / self.nx as f64
                     + signed(iy, self.ny) as f64 * my0 as f64 / self.ny as f64);
-            let e = Complex64::from_polar(1.0, w * (t_s - self.t_ref_s));
-            let v = (p * e + q * e.conj()) * Complex64::from_polar(1.0, turn);
-            out[index] = v;
+            let e = Complex64::from_polar(1.0, b.omega_rad_s * (t_s - self.t_ref_s));
+            let v = (b.p * e + b.q * e.conj()) * Complex64::from_polar(1.0, turn);
+            out[b.index] = v;
             out[((self.ny - iy) % self.ny) * self.nx + (self.nx - ix) % self.nx] = v.conj();
         }
         Some(())
@@ -130,7 +129,7 @@ pub(super) fn masked_fit(
             if unseen.iter().any(|u| !u.is_empty()) {
                 for _ in 0..FILL_PASSES {
                     let own = ScanFit {
-                        bins: fits.iter().map(|b| (b.index, b.omega_rad_s, b.p, b.q)).collect(),
+                        bins: std::mem::take(&mut fits),
                         ..fit.clone()
                     };
                     let spectra = fill(&own).unwrap_or_else(|| seen_spectra.clone());
@@ -140,8 +139,9 @@ pub(super) fn masked_fit(
             fits
         }
     };
-    fit.bins = fits.iter().map(|b| (b.index, b.omega_rad_s, b.p, b.q)).collect();
-    Ok((lattice.field(zeroed, &fits, opts)?, fit))
+    let field = lattice.field(zeroed, &fits, opts)?;
+    fit.bins = fits;
+    Ok((field, fit))
 }
 
 /// Adds to a scan's spectrum that of its unseen cells filled from a spectrum.
